@@ -1,0 +1,41 @@
+// Pinhole intrinsics of the colour image, the depth scale, and back-projection.
+#pragma once
+
+#include <string>
+
+#include <Eigen/Core>
+
+namespace acvo {
+
+struct Camera {
+  double fx = 525.0;
+  double fy = 525.0;
+  double cx = 319.5;
+  double cy = 239.5;
+  int width = 640;
+  int height = 480;
+  // Raw depth units per metre: 5000 for TUM PNG, 1000 for 16UC1 millimetres, 1 for metres.
+  double depth_scale = 5000.0;
+
+  // Pixel (u, v) at depth z metres -> point in the optical frame (x right, y down, z forward).
+  Eigen::Vector3d backProject(double u, double v, double z) const {
+    return {(u - cx) * z / fx, (v - cy) * z / fy, z};
+  }
+  // Optical-frame point -> pixel coordinates (z must be positive).
+  Eigen::Vector2d project(const Eigen::Vector3d& p) const {
+    return {fx * p.x() / p.z() + cx, fy * p.y() / p.z() + cy};
+  }
+  bool valid() const;  // positive focal lengths, positive size and depth scale, all finite
+};
+
+// Named intrinsics of the TUM RGB-D benchmark: "fr1", "fr2", "fr3", "default"
+// (default = 525, 525, 319.5, 239.5); all 640x480 with depth scale 5000.
+// Throws std::invalid_argument for an unknown name.
+Camera cameraByName(const std::string& name);
+
+// Reads a camera.yaml (keys fx, fy, cx, cy, width, height, depth_scale; depth_scale optional,
+// default 5000). Throws std::runtime_error naming the file and the problem.
+Camera loadCameraYaml(const std::string& path);
+void saveCameraYaml(const std::string& path, const Camera& camera);
+
+}  // namespace acvo

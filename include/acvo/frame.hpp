@@ -1,0 +1,26 @@
+// One RGB-D frame: colour (8-bit, known channel order), depth in metres, intrinsics, stamp.
+#pragma once
+
+#include <string>
+
+#include <opencv2/core.hpp>
+
+#include "acvo/camera.hpp"
+
+namespace acvo {
+
+enum class ColorOrder { kRgb, kBgr, kGray };
+
+struct Frame {
+  cv::Mat color;  // CV_8UC3 in `order` (kRgb or kBgr), or CV_8UC1 for kGray
+  ColorOrder order = ColorOrder::kBgr;
+  cv::Mat depth;  // CV_32FC1 metres, 0 = invalid, same size as colour
+  Camera camera;
+  double stamp = 0.0;  // seconds
+
+  // Empty string when the frame is usable; otherwise says what is wrong with it
+  // (empty images, wrong types, size mismatch between colour, depth and camera).
+  std::string problem() const;
+};
+
+}  // namespace acvo

@@ -1,0 +1,95 @@
+// The kernel a_ij, its sparsification, and the per-cloud structures the solver reuses:
+// a uniform voxel grid for the cross-pair search and the self-kernel pairs (method.md §2, §4).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "acvo/labelled_cloud.hpp"
+#include "acvo/params.hpp"
+
+namespace acvo {
+
+// Smallest s* such that |g(s) - L_n(s)| <= tol for all s >= s*, where g(s) = exp(-1/(2 s^2))
+// and L_n its expansion about s = infinity truncated at order n in 1/s (method.md §5).
+// Returns g(s*), the sparsification threshold divided by sigma^2.
+// (4, 1e-3) -> 0.8315, (6, 1e-3) -> 0.6694.
+double sparsificationThreshold(int order, double tolerance);
+
+// Squared spatial radius beyond which sigma^2 exp(-d^2 / 2 ell^2) < threshold, i.e. no pair can
+// survive sparsification whatever its colour. Zero when even d = 0 does not survive.
+double spatialRadius2(double ell, double sigma, double threshold);
+
+// Colour factor sigma_c^2 exp(-|f - g|^2 / 2 ell_c^2).
+inline float colorFactor(const Label& f, const Label& g, float color_ell2x2_inv, float color_sigma2) {
+  return color_sigma2 * std::exp(-(f - g).squaredNorm() * color_ell2x2_inv);
+}
+
+// A uniform grid over a cloud's bounding box; cells of `cell` metres. Points are stored in cell
+// order so that a row of cells along x is one contiguous range.
+class VoxelGrid {
+ public:
+  VoxelGrid() = default;
+  VoxelGrid(const std::vector<Eigen::Vector3f>& points, float cell);
+
+  float cell() const { return cell_; }
+  bool empty() const { return order_.empty(); }
+  // Calls f(index) for every point in the 3x3x3 cells around q (a superset of the points
+  // within `cell` of q).
+  template <typename F>
+  void forEachCandidate(const Eigen::Vector3f& q, F&& f) const;
+
+ private:
+  float cell_ = 0.0f;
+  Eigen::Vector3f origin_ = Eigen::Vector3f::Zero();
+  int nx_ = 0, ny_ = 0, nz_ = 0;
+  std::vector<int> cell_start_;  // size nx*ny*nz + 1
+  std::vector<int> order_;       // point indices sorted by cell
+};
+
+// A pair of distinct points of one cloud with their squared distance and colour factor.
+struct SelfPair {
+  int i = 0, j = 0;  // i < j
+  float d2 = 0.0f;
+  float color = 0.0f;
+};
+
+// A cloud ready for registration: its points, labels, search grid and self-kernel pairs,
+// computed once per frame (the self-kernel of frame k is the fixed self-kernel of frame k+1).
+struct PreparedCloud {
+  LabelledCloud cloud;
+  VoxelGrid grid;                 // cell = the search radius at the largest length-scale
+  std::vector<SelfPair> self_pairs;  // all pairs within that radius that can pass the threshold
+  double ms_prepare = 0.0;
+
+  std::size_t size() const { return cloud.size(); }
+};
+
+// The largest spatial length-scale the solver may use with these parameters.
+double largestEll(const SolverParams& params);
+
+PreparedCloud prepareCloud(LabelledCloud cloud, const SolverParams& params);
+
+// ---------------------------------------------------------------------------------------------
+template <typename F>
+void VoxelGrid::forEachCandidate(const Eigen::Vector3f& q, F&& f) const {
+  if (order_.empty()) return;
+  const Eigen::Vector3f r = (q - origin_) / cell_;
+  const int cx = static_cast<int>(std::floor(r.x()));
+  const int cy = static_cast<int>(std::floor(r.y()));
+  const int cz = static_cast<int>(std::floor(r.z()));
+  if (!(cx >= -1 && cy >= -1 && cz >= -1 && cx <= nx_ && cy <= ny_ && cz <= nz_)) return;
+  const int x0 = std::max(cx - 1, 0), x1 = std::min(cx + 1, nx_ - 1);
+  if (x0 > x1) return;
+  for (int z = std::max(cz - 1, 0); z <= std::min(cz + 1, nz_ - 1); ++z) {
+    for (int y = std::max(cy - 1, 0); y <= std::min(cy + 1, ny_ - 1); ++y) {
+      const int row = (z * ny_ + y) * nx_;
+      const int begin = cell_start_[row + x0], end = cell_start_[row + x1 + 1];
+      for (int k = begin; k < end; ++k) f(order_[k]);
+    }
+  }
+}
+
+}  // namespace acvo

@@ -1,0 +1,44 @@
+// A labelled semi-dense point cloud: points in the camera optical frame + 5-D labels
+// [H, S, V, gx, gy] (method.md §1).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "acvo/frame.hpp"
+#include "acvo/params.hpp"
+#include "acvo/point_selector.hpp"
+
+namespace acvo {
+
+using Label = Eigen::Matrix<float, 5, 1>;
+
+struct LabelledCloud {
+  std::vector<Eigen::Vector3f> points;            // optical frame, metres
+  std::vector<Label> labels;                      // H/180, S/255, V/255, gx/255*2, gy/255*2
+  std::vector<cv::Point> pixels;                  // where each point came from
+  std::vector<std::array<std::uint8_t, 3>> rgb;   // colour of each point, R G B
+  double stamp = 0.0;
+  int width = 0, height = 0;  // image size it was built from
+
+  std::size_t size() const { return points.size(); }
+  bool empty() const { return points.empty(); }
+};
+
+struct CloudStats {
+  Selection selection;  // what the selector did (pixels are moved into the cloud)
+  double ms_selection = 0.0;
+  double ms_labels = 0.0;
+};
+
+// Builds the cloud of a frame. The frame must be usable (Frame::problem() empty); HSV is
+// computed from the image's real channel order. gx, gy are central differences of the grey
+// image (0.5 * (I[u+1] - I[u-1])).
+LabelledCloud buildLabelledCloud(const Frame& frame, const SelectionParams& params,
+                                 CloudStats* stats = nullptr);
+
+}  // namespace acvo

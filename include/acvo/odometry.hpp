@@ -1,0 +1,62 @@
+// Frame-to-frame odometry: owns the previous cloud, builds each cloud once, guesses the
+// motion (constant velocity or identity), registers, composes the pose, judges tracking.
+#pragma once
+
+#include <optional>
+
+#include <Eigen/Geometry>
+
+#include "acvo/frame.hpp"
+#include "acvo/labelled_cloud.hpp"
+#include "acvo/params.hpp"
+#include "acvo/solver.hpp"
+
+namespace acvo {
+
+enum class Tracking { kOk, kHard, kLost, kFirstFrame, kBadFrame };
+std::string toString(Tracking t);
+
+struct OdometryResult {
+  Tracking tracking = Tracking::kBadFrame;
+  std::string message;  // why tracking is hard / lost / the frame is bad; empty when ok
+  // Camera pose of this frame in the odometry frame (the first frame's camera, or the pose
+  // given to reset()), optical-frame convention.
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  // Motion from this frame's camera to the previous frame's camera (T: current -> previous).
+  Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
+  // Covariance of the relative motion (left perturbation, order: rotation x y z, translation
+  // x y z; rad^2 and m^2), in this frame's camera frame.
+  Eigen::Matrix<double, 6, 6> motion_covariance = Eigen::Matrix<double, 6, 6>::Identity();
+  SolverResult solver;
+  std::size_t fixed_points = 0;
+  std::size_t moving_points = 0;
+  double ms_cloud = 0.0;         // building this frame's cloud (selection + labels + self-kernel)
+  double ms_registration = 0.0;  // the solver
+  CloudStats cloud_stats;
+};
+
+class Odometry {
+ public:
+  explicit Odometry(const Params& params = Params());
+
+  // Processes one frame. A frame with a problem (Frame::problem()) is rejected with
+  // Tracking::kBadFrame and does not change the state.
+  OdometryResult process(const Frame& frame);
+
+  // Drops the reference cloud; the next frame starts again from `pose`.
+  void reset(const Eigen::Isometry3d& pose = Eigen::Isometry3d::Identity());
+
+  const Eigen::Isometry3d& pose() const { return pose_; }
+  const Params& params() const { return params_; }
+  // The cloud of the last processed frame (the current reference), if any.
+  const LabelledCloud* lastCloud() const;
+
+ private:
+  Params params_;
+  Eigen::Isometry3d pose_ = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();  // last relative motion
+  std::optional<PreparedCloud> reference_;
+  int lost_streak_ = 0;
+};
+
+}  // namespace acvo

@@ -1,0 +1,103 @@
+// Every parameter of the method in one struct, with the paper's defaults (method.md §6).
+// One table (visitParams) names each field once; the YAML loader, the ROS parameter loader
+// and the documentation all walk that table.
+#pragma once
+
+#include <string>
+
+namespace acvo {
+
+enum class EllPolicy { kAdaptive, kFixedSchedule };
+enum class EllUpdate { kDescent, kReference };
+enum class InitialGuess { kConstantVelocity, kIdentity };
+
+struct SelectionParams {
+  int target_points = 3000;  // semi-dense cloud size the selector aims at
+  double min_depth = 0.1;    // m; points outside [min_depth, max_depth] are dropped
+  double max_depth = 6.0;    // m
+  bool canny_fallback = true;  // add Canny edge pixels when fewer than target/3 were selected
+};
+
+struct SolverParams {
+  EllPolicy ell_policy = EllPolicy::kAdaptive;  // adaptive (A-CVO) or fixed_schedule (CVO)
+  EllUpdate ell_update = EllUpdate::kDescent;   // descent (paper) or reference (authors' code)
+  double ell_init = 0.1;        // m, initial spatial length-scale (reset per frame)
+  double ell_min = 0.0391;      // m
+  double ell_max = 0.15;        // m (only shrinks within a frame, reset per frame)
+  double ell_step = 0.3;        // gamma_l, step of the length-scale update
+  double ell_reduction = 0.7;   // lambda_l, factor applied to ell_max when ell reaches it
+  double sigma = 0.1;           // spatial signal std
+  double color_ell = 0.5;       // colour length-scale (measured, see config/acvo.yaml)
+  double color_sigma = 1.0;     // colour signal std
+  double sparsification = 8.315e-3;  // a_ij below this are dropped
+  double eps_transform = 1e-5;  // stop when t*|xi| < eps_transform
+  double eps_gradient = 5e-5;   // stop when |omega| < eps and |v| < eps
+  double min_step = 0.2;        // step when the cubic has no positive root
+  double max_step = 0.8;        // cap on the step
+  double omega_scale = 7.0;     // c: omega = (1/c) sum a (x cross y)
+  double v_scale = 7.0;         // d: v = (1/d) sum a (y - x)
+  int max_iterations = 200;     // reference code: 2000 (too many for real time)
+  int min_points = 30;          // fewer points in either cloud -> status too_few_points
+};
+
+struct OdometryParams {
+  InitialGuess initial_guess = InitialGuess::kConstantVelocity;
+  int threads = 0;  // 0 = all cores
+};
+
+struct Params {
+  SelectionParams selection;
+  SolverParams solver;
+  OdometryParams odometry;
+};
+
+std::string toString(EllPolicy v);
+std::string toString(EllUpdate v);
+std::string toString(InitialGuess v);
+// Throw std::invalid_argument listing the accepted values.
+void fromString(const std::string& s, EllPolicy& v);
+void fromString(const std::string& s, EllUpdate& v);
+void fromString(const std::string& s, InitialGuess& v);
+
+// Calls visit(section, name, field) for every parameter; field is int&, double&, bool& or one
+// of the enums above. Sections: "selection", "solver", "odometry".
+template <typename Params_, typename Visitor>
+void visitParams(Params_& p, Visitor&& visit) {
+  visit("selection", "target_points", p.selection.target_points);
+  visit("selection", "min_depth", p.selection.min_depth);
+  visit("selection", "max_depth", p.selection.max_depth);
+  visit("selection", "canny_fallback", p.selection.canny_fallback);
+  visit("solver", "ell_policy", p.solver.ell_policy);
+  visit("solver", "ell_update", p.solver.ell_update);
+  visit("solver", "ell_init", p.solver.ell_init);
+  visit("solver", "ell_min", p.solver.ell_min);
+  visit("solver", "ell_max", p.solver.ell_max);
+  visit("solver", "ell_step", p.solver.ell_step);
+  visit("solver", "ell_reduction", p.solver.ell_reduction);
+  visit("solver", "sigma", p.solver.sigma);
+  visit("solver", "color_ell", p.solver.color_ell);
+  visit("solver", "color_sigma", p.solver.color_sigma);
+  visit("solver", "sparsification", p.solver.sparsification);
+  visit("solver", "eps_transform", p.solver.eps_transform);
+  visit("solver", "eps_gradient", p.solver.eps_gradient);
+  visit("solver", "min_step", p.solver.min_step);
+  visit("solver", "max_step", p.solver.max_step);
+  visit("solver", "omega_scale", p.solver.omega_scale);
+  visit("solver", "v_scale", p.solver.v_scale);
+  visit("solver", "max_iterations", p.solver.max_iterations);
+  visit("solver", "min_points", p.solver.min_points);
+  visit("odometry", "initial_guess", p.odometry.initial_guess);
+  visit("odometry", "threads", p.odometry.threads);
+}
+
+// Empty when the values are consistent; otherwise a message naming the offending parameter.
+std::string validate(const Params& p);
+
+// Loads a YAML file with the sections above. Unknown sections or keys, wrong value types and
+// inconsistent values throw std::runtime_error naming the file and the key.
+Params loadParams(const std::string& path);
+// Applies a YAML text on top of `base` (same rules); used by loadParams and by tests.
+Params parseParams(const std::string& yaml_text, const Params& base = Params(),
+                   const std::string& source_name = "<string>");
+
+}  // namespace acvo

@@ -1,0 +1,52 @@
+// One A-CVO / CVO registration (method.md §3-§4): maximise the RKHS inner product of two
+// labelled clouds over SE(3), with a fixed length-scale schedule or the adaptive one.
+#pragma once
+
+#include <string>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "acvo/kernel.hpp"
+#include "acvo/params.hpp"
+
+namespace acvo {
+
+enum class SolverStatus { kConverged, kMaxIterations, kTooFewPoints, kNotFinite };
+std::string toString(SolverStatus s);
+
+struct SolverResult {
+  // Maps points of the moving (current) cloud into the fixed (previous) cloud's frame.
+  Eigen::Isometry3d transform = Eigen::Isometry3d::Identity();
+  SolverStatus status = SolverStatus::kTooFewPoints;
+  int iterations = 0;
+  double ell = 0.0;            // final spatial length-scale
+  bool ell_at_bound = false;   // final ell pinned at ell_min or at the (shrunk) ell_max
+  int ell_bound_iterations = 0;  // iterations that ended with ell pinned at a bound
+  std::size_t nnz = 0;         // kept cross-kernel entries at the last iteration
+  double inner_product = 0.0;  // <f_X, h.f_Z> / (|f_X| |f_Z|), in [0, 1]
+  // Curvature of the objective F at the optimum w.r.t. a left perturbation
+  // (omega, v) of the transform, 6x6, negative semi-definite at a maximum.
+  Eigen::Matrix<double, 6, 6> hessian = Eigen::Matrix<double, 6, 6>::Zero();
+  double objective = 0.0;      // F at the optimum
+  // Time per stage, milliseconds.
+  double ms_total = 0.0;
+  double ms_neighbours = 0.0;  // cross-pair search + kernel + gradient pass
+  double ms_step = 0.0;        // step-size pass
+  double ms_ell = 0.0;         // length-scale update
+};
+
+// Registers `moving` onto `fixed` starting from `guess`. Both clouds must have been prepared
+// (their self-kernels and search grids built, see kernel.hpp) with the same parameters.
+SolverResult align(const PreparedCloud& fixed, const PreparedCloud& moving,
+                   const Eigen::Isometry3d& guess, const SolverParams& params);
+
+// Step size: the smallest positive real root of 4E t^3 + 3D t^2 + 2C t + B = 0; min_step when
+// there is none; capped at max_step. Double precision, degenerate leading terms handled.
+double solveStep(double B, double C, double D, double E, double min_step, double max_step);
+
+// The length-scale for a fixed-schedule iteration (CVO: 0.15, 0.10 after 2, 0.06 after 9,
+// 0.03 after 19).
+double scheduledEll(int iteration);
+
+}  // namespace acvo

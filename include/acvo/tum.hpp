@@ -1,0 +1,83 @@
+// TUM RGB-D benchmark formats: image lists, rgb/depth association, trajectories, datasets.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "acvo/camera.hpp"
+#include "acvo/frame.hpp"
+
+namespace acvo {
+
+// One line of rgb.txt / depth.txt: "timestamp path". The stamp text is kept verbatim so that
+// outputs repeat it exactly.
+struct TumListEntry {
+  std::string stamp_text;
+  double stamp = 0.0;
+  std::string path;  // relative to the dataset folder, as written in the list
+};
+
+struct TumAssociation {
+  TumListEntry rgb;
+  TumListEntry depth;
+};
+
+// A pose with its stamp: camera-to-world (TUM convention), stamp text kept verbatim.
+struct StampedPose {
+  std::string stamp_text;
+  double stamp = 0.0;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+};
+using Trajectory = std::vector<StampedPose>;
+
+// Reads "timestamp path" lists; '#' lines and blank lines skipped. Throws std::runtime_error
+// naming the file (and line number for a malformed line).
+std::vector<TumListEntry> readTumList(const std::string& path);
+
+// Reads associations.txt ("rgb_ts rgb_path depth_ts depth_path").
+std::vector<TumAssociation> readAssociations(const std::string& path);
+
+// Nearest-timestamp association as TUM's associate.py does: candidate pairs with
+// |t_rgb - t_depth| < max_difference, taken greedily by increasing difference, each entry used
+// at most once; the result is sorted by rgb stamp.
+std::vector<TumAssociation> associate(const std::vector<TumListEntry>& rgb,
+                                      const std::vector<TumListEntry>& depth,
+                                      double max_difference = 0.02);
+
+// TUM trajectory files: "timestamp tx ty tz qx qy qz qw". Commas and tabs also separate;
+// '#' lines are skipped. Throws with file and line number for a malformed line.
+Trajectory readTrajectory(const std::string& path);
+// Writes with the stamp text as given and full double precision.
+void writeTrajectory(const std::string& path, const Trajectory& trajectory,
+                     const std::string& header_comment = "");
+
+// A TUM-format dataset folder: rgb.txt, depth.txt, optional associations.txt,
+// optional groundtruth.txt, optional camera.yaml.
+class TumDataset {
+ public:
+  // `camera`: empty = camera.yaml in the folder if present, else "default"; a name
+  // (fr1, fr2, fr3, default) or a path to a camera yaml overrides it.
+  explicit TumDataset(const std::string& folder, const std::string& camera = "");
+
+  const std::string& folder() const { return folder_; }
+  const Camera& camera() const { return camera_; }
+  const std::vector<TumAssociation>& frames() const { return frames_; }
+  std::size_t size() const { return frames_.size(); }
+  const std::optional<Trajectory>& groundtruth() const { return groundtruth_; }
+
+  // Loads frame i: colour as BGR (OpenCV's order, marked in Frame::order), depth converted to
+  // metres with the camera's depth scale. Throws std::runtime_error naming the file when an
+  // image does not load, has the wrong type, or its size differs from the camera's.
+  Frame loadFrame(std::size_t i) const;
+
+ private:
+  std::string folder_;
+  Camera camera_;
+  std::vector<TumAssociation> frames_;
+  std::optional<Trajectory> groundtruth_;
+};
+
+}  // namespace acvo

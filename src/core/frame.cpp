@@ -1,0 +1,34 @@
+#include "acvo/frame.hpp"
+
+#include <sstream>
+
+namespace acvo {
+
+std::string Frame::problem() const {
+  std::ostringstream why;
+  if (color.empty()) return "colour image is empty";
+  if (depth.empty()) return "depth image is empty";
+  const int want_color = order == ColorOrder::kGray ? CV_8UC1 : CV_8UC3;
+  if (color.type() != want_color) {
+    why << "colour image has type " << cv::typeToString(color.type()) << ", expected "
+        << cv::typeToString(want_color);
+    return why.str();
+  }
+  if (depth.type() != CV_32FC1) {
+    return "depth image has type " + cv::typeToString(depth.type()) + ", expected 32FC1 metres";
+  }
+  if (color.size() != depth.size()) {
+    why << "colour is " << color.cols << "x" << color.rows << " but depth is " << depth.cols << "x"
+        << depth.rows;
+    return why.str();
+  }
+  if (!camera.valid()) return "camera intrinsics are invalid (zero or non-finite focal length)";
+  if (camera.width != color.cols || camera.height != color.rows) {
+    why << "camera is " << camera.width << "x" << camera.height << " but the images are "
+        << color.cols << "x" << color.rows;
+    return why.str();
+  }
+  return {};
+}
+
+}  // namespace acvo
