@@ -1,0 +1,32 @@
+// Helpers shared by the unit tests: where the repository and the shared data live.
+#pragma once
+
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
+namespace acvo::test {
+
+// The repository's root (for test/data fixtures and config/).
+inline std::filesystem::path sourceDir() { return ACVO_SOURCE_DIR; }
+
+// ../shared/data beside the repository, or ACVO_SHARED_DATA when set. Empty when absent:
+// tests that need it call GTEST_SKIP() with a reason.
+inline std::filesystem::path sharedDataDir() {
+  std::filesystem::path p = ACVO_SHARED_DATA_DIR;
+  if (const char* env = std::getenv("ACVO_SHARED_DATA")) p = env;
+  return std::filesystem::is_directory(p) ? p : std::filesystem::path();
+}
+
+// Folder of the built tools (acvo_synth, acvo_tum, acvo_eval).
+inline std::filesystem::path toolsDir() { return ACVO_TOOLS_DIR; }
+
+// A fresh temporary folder for one test.
+inline std::filesystem::path tempDir(const std::string& name) {
+  auto p = std::filesystem::temp_directory_path() / ("acvo_test_" + name);
+  std::filesystem::remove_all(p);
+  std::filesystem::create_directories(p);
+  return p;
+}
+
+}  // namespace acvo::test
