@@ -1,0 +1,254 @@
+#include "conversions.hpp"
+
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+
+#include <opencv2/imgproc.hpp>
+#include <sensor_msgs/image_encodings.h>
+#include <tf2_eigen/tf2_eigen.h>
+
+#include "acvo/depth.hpp"
+
+namespace acvo_ros {
+namespace enc = sensor_msgs::image_encodings;
+
+namespace {
+
+bool hostIsBigEndian() {
+  const std::uint16_t one = 1;
+  std::uint8_t first = 0;
+  std::memcpy(&first, &one, 1);
+  return first == 0;
+}
+
+// A view of the message's pixels (no copy); valid while `msg` lives.
+cv::Mat view(const sensor_msgs::Image& msg, int cv_type) {
+  return cv::Mat(static_cast<int>(msg.height), static_cast<int>(msg.width), cv_type,
+                 const_cast<std::uint8_t*>(msg.data.data()), msg.step);
+}
+
+}  // namespace
+
+std::string stripSlash(const std::string& frame_id) {
+  std::size_t first = 0;
+  while (first < frame_id.size() && frame_id[first] == '/') ++first;
+  return frame_id.substr(first);
+}
+
+std::string layoutProblem(const sensor_msgs::Image& msg) {
+  int channels = 0, bits = 0;
+  try {
+    channels = enc::numChannels(msg.encoding);
+    bits = enc::bitDepth(msg.encoding);
+  } catch (const std::exception&) {
+    return "unknown encoding '" + msg.encoding + "'";
+  }
+  if (msg.width == 0 || msg.height == 0) return "empty image (0 pixels)";
+  if (bits > 8 && static_cast<bool>(msg.is_bigendian) != hostIsBigEndian()) {
+    return "byte order of the data differs from this machine's (is_bigendian = " +
+           std::to_string(msg.is_bigendian) + ")";
+  }
+  const std::uint64_t row_bytes = std::uint64_t{msg.width} * channels * bits / 8;
+  if (msg.step < row_bytes) {
+    return "step " + std::to_string(msg.step) + " is shorter than a row of " +
+           std::to_string(msg.width) + " " + msg.encoding + " pixels (" +
+           std::to_string(row_bytes) + " bytes)";
+  }
+  const std::uint64_t needed = std::uint64_t{msg.step} * msg.height;
+  if (msg.data.size() < needed) {
+    return "truncated data: " + std::to_string(msg.data.size()) + " bytes for " +
+           std::to_string(msg.height) + " rows of step " + std::to_string(msg.step) + " (" +
+           std::to_string(needed) + " bytes)";
+  }
+  return {};
+}
+
+ColorImage decodeColor(const sensor_msgs::Image& msg) {
+  ColorImage out;
+  const std::string& e = msg.encoding;
+  if (e != enc::RGB8 && e != enc::BGR8 && e != enc::RGBA8 && e != enc::BGRA8 && e != enc::MONO8) {
+    out.problem = "unsupported colour encoding '" + e +
+                  "' (expected rgb8, bgr8, rgba8, bgra8 or mono8)";
+    return out;
+  }
+  out.problem = layoutProblem(msg);
+  if (!out.problem.empty()) return out;
+
+  if (e == enc::RGB8 || e == enc::BGR8) {
+    out.image = view(msg, CV_8UC3).clone();
+  } else if (e == enc::RGBA8 || e == enc::BGRA8) {
+    // Same conversion code for both: dropping the 4th channel keeps the channel order.
+    cv::cvtColor(view(msg, CV_8UC4), out.image, cv::COLOR_RGBA2RGB);
+  } else {
+    out.image = view(msg, CV_8UC1).clone();
+  }
+  out.order = (e == enc::MONO8)                   ? acvo::ColorOrder::kGray
+              : (e == enc::RGB8 || e == enc::RGBA8) ? acvo::ColorOrder::kRgb
+                                                    : acvo::ColorOrder::kBgr;
+  return out;
+}
+
+DepthImage decodeDepth(const sensor_msgs::Image& msg) {
+  DepthImage out;
+  int cv_type = 0;
+  if (msg.encoding == enc::TYPE_16UC1 || msg.encoding == enc::MONO16) {
+    cv_type = CV_16UC1;
+    out.units_per_metre = 1000.0;  // REP 118: 16-bit depth is in millimetres
+  } else if (msg.encoding == enc::TYPE_32FC1) {
+    cv_type = CV_32FC1;
+    out.units_per_metre = 1.0;
+  } else {
+    out.problem = "unsupported depth encoding '" + msg.encoding +
+                  "' (expected 16UC1 millimetres or 32FC1 metres)";
+    return out;
+  }
+  out.problem = layoutProblem(msg);
+  if (!out.problem.empty()) return out;
+  out.metres = acvo::depthToMeters(view(msg, cv_type), out.units_per_metre);
+  return out;
+}
+
+std::string IntrinsicsOverride::problem() const {
+  const bool any = fx != 0.0 || fy != 0.0 || cx != 0.0 || cy != 0.0;
+  if (any && !explicitValues()) {
+    return "fx, fy, cx, cy must all be set and positive to override the intrinsics (got " +
+           std::to_string(fx) + ", " + std::to_string(fy) + ", " + std::to_string(cx) + ", " +
+           std::to_string(cy) + ")";
+  }
+  if (named()) {
+    try {
+      acvo::cameraByName(camera);
+    } catch (const std::exception& e) {
+      return "camera '" + camera + "': " + e.what() + " (use \"\" or \"info\" for camera_info)";
+    }
+  }
+  return {};
+}
+
+CameraResult cameraFor(const sensor_msgs::CameraInfo& info, int width, int height,
+                       const IntrinsicsOverride& override_intrinsics) {
+  CameraResult out;
+  out.problem = override_intrinsics.problem();
+  if (!out.problem.empty()) return out;
+  acvo::Camera& cam = out.camera;
+
+  if (override_intrinsics.explicitValues()) {
+    cam.fx = override_intrinsics.fx;
+    cam.fy = override_intrinsics.fy;
+    cam.cx = override_intrinsics.cx;
+    cam.cy = override_intrinsics.cy;
+  } else if (override_intrinsics.named()) {
+    cam = acvo::cameraByName(override_intrinsics.camera);
+    // Named intrinsics are for 640x480; a driver streaming another resolution of the same
+    // sensor scales them.
+    const double sx = static_cast<double>(width) / cam.width;
+    const double sy = static_cast<double>(height) / cam.height;
+    cam.fx *= sx;
+    cam.cx *= sx;
+    cam.fy *= sy;
+    cam.cy *= sy;
+  } else {
+    const auto& K = info.K;
+    if (!(K[0] > 0.0 && K[4] > 0.0 && std::isfinite(K[0]) && std::isfinite(K[4]) &&
+          std::isfinite(K[2]) && std::isfinite(K[5]))) {
+      out.problem = "camera_info K has a zero, negative or non-finite focal length or centre (fx " +
+                    std::to_string(K[0]) + ", fy " + std::to_string(K[4]) + ")";
+      return out;
+    }
+    if (static_cast<int>(info.width) != width || static_cast<int>(info.height) != height) {
+      out.problem = "camera_info size " + std::to_string(info.width) + "x" +
+                    std::to_string(info.height) + " differs from the image's " +
+                    std::to_string(width) + "x" + std::to_string(height);
+      return out;
+    }
+    cam.fx = K[0];
+    cam.fy = K[4];
+    cam.cx = K[2];
+    cam.cy = K[5];
+  }
+  cam.width = width;
+  cam.height = height;
+  cam.depth_scale = 1.0;  // the frame's depth is already in metres
+  return out;
+}
+
+Eigen::Isometry3d conjugate(const Eigen::Isometry3d& base_from_cam, const Eigen::Isometry3d& t) {
+  return base_from_cam * t * base_from_cam.inverse();
+}
+
+Twist twistOf(const Eigen::Isometry3d& delta, double dt) {
+  Twist out;
+  if (!(dt > 0.0)) return out;
+  const Eigen::AngleAxisd aa(delta.rotation());
+  out.linear = delta.translation() / dt;
+  out.angular = aa.axis() * aa.angle() / dt;
+  return out;
+}
+
+geometry_msgs::Pose toPoseMsg(const Eigen::Isometry3d& pose) { return tf2::toMsg(pose); }
+
+Eigen::Isometry3d fromPoseMsg(const geometry_msgs::Pose& pose, std::string* problem) {
+  const auto& q = pose.orientation;
+  Eigen::Quaterniond quat(q.w, q.x, q.y, q.z);
+  const auto& p = pose.position;
+  if (!(quat.norm() > 1e-9) || !std::isfinite(quat.norm()) || !std::isfinite(p.x) ||
+      !std::isfinite(p.y) || !std::isfinite(p.z)) {
+    if (problem) *problem = "the pose has a zero or non-finite orientation or position";
+    return Eigen::Isometry3d::Identity();
+  }
+  quat.normalize();
+  Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
+  out.linear() = quat.toRotationMatrix();
+  out.translation() = Eigen::Vector3d(p.x, p.y, p.z);
+  if (problem) problem->clear();
+  return out;
+}
+
+geometry_msgs::TransformStamped toTransformMsg(const Eigen::Isometry3d& pose,
+                                               const std::string& parent,
+                                               const std::string& child, const ros::Time& stamp) {
+  geometry_msgs::TransformStamped t = tf2::eigenToTransform(pose);
+  t.header.stamp = stamp;
+  t.header.frame_id = parent;
+  t.child_frame_id = child;
+  return t;
+}
+
+sensor_msgs::PointCloud2 toPointCloud2(const acvo::LabelledCloud& cloud,
+                                       const std_msgs::Header& header) {
+  sensor_msgs::PointCloud2 msg;
+  msg.header = header;
+  msg.height = 1;
+  msg.width = static_cast<std::uint32_t>(cloud.size());
+  const char* names[] = {"x", "y", "z", "rgb"};
+  for (int i = 0; i < 4; ++i) {
+    sensor_msgs::PointField f;
+    f.name = names[i];
+    f.offset = 4 * i;
+    f.datatype = sensor_msgs::PointField::FLOAT32;
+    f.count = 1;
+    msg.fields.push_back(f);
+  }
+  msg.is_bigendian = hostIsBigEndian();
+  msg.point_step = 16;
+  msg.row_step = msg.point_step * msg.width;
+  msg.is_dense = true;
+  msg.data.resize(std::size_t{msg.row_step});
+  const bool has_rgb = cloud.rgb.size() == cloud.size();
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    float xyzc[4];
+    xyzc[0] = cloud.points[i].x();
+    xyzc[1] = cloud.points[i].y();
+    xyzc[2] = cloud.points[i].z();
+    const std::uint32_t packed =
+        has_rgb ? (std::uint32_t{cloud.rgb[i][0]} << 16) | (std::uint32_t{cloud.rgb[i][1]} << 8) |
+                      std::uint32_t{cloud.rgb[i][2]}
+                : 0x808080u;
+    std::memcpy(&xyzc[3], &packed, 4);
+    std::memcpy(&msg.data[i * msg.point_step], xyzc, sizeof xyzc);
+  }
+  return msg;
+}
+
+}  // namespace acvo_ros

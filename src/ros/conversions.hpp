@@ -1,0 +1,93 @@
+// Messages <-> core types for the odometry nodelet: images and camera info to an acvo::Frame,
+// poses to messages, the labelled cloud to PointCloud2. No state, no algorithm; every decoder
+// returns a value with an empty `problem` on success or a sentence saying what is wrong.
+#pragma once
+
+#include <string>
+
+#include <Eigen/Geometry>
+#include <geometry_msgs/Pose.h>
+#include <geometry_msgs/TransformStamped.h>
+#include <opencv2/core.hpp>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <std_msgs/Header.h>
+
+#include "acvo/camera.hpp"
+#include "acvo/frame.hpp"
+#include "acvo/labelled_cloud.hpp"
+
+namespace acvo_ros {
+
+// TUM bags and older drivers write frame ids as "/name"; tf2 wants "name".
+std::string stripSlash(const std::string& frame_id);
+
+// Why the image's buffer cannot be read as `encoding` (unknown encoding, big-endian data, step
+// shorter than a row, data shorter than step * height); empty when it can.
+std::string layoutProblem(const sensor_msgs::Image& msg);
+
+struct ColorImage {
+  cv::Mat image;  // CV_8UC3 in `order`, or CV_8UC1 for mono8; owns its pixels
+  acvo::ColorOrder order = acvo::ColorOrder::kRgb;
+  std::string problem;
+};
+// rgb8, bgr8, rgba8, bgra8 (alpha dropped) and mono8.
+ColorImage decodeColor(const sensor_msgs::Image& msg);
+
+struct DepthImage {
+  cv::Mat metres;  // CV_32FC1, 0 = invalid
+  double units_per_metre = 1.0;  // 1000 for 16UC1 millimetres, 1 for 32FC1 metres
+  std::string problem;
+};
+// 16UC1 (millimetres, 0 = invalid) and 32FC1 (metres, NaN/0 = invalid).
+DepthImage decodeDepth(const sensor_msgs::Image& msg);
+
+// Where intrinsics come from when not from CameraInfo: a TUM name ("fr1", "fr2", "fr3",
+// "default"; "" or "info" = use CameraInfo) or explicit fx, fy, cx, cy (all four > 0).
+struct IntrinsicsOverride {
+  std::string camera;
+  double fx = 0.0, fy = 0.0, cx = 0.0, cy = 0.0;
+
+  bool explicitValues() const { return fx > 0.0 && fy > 0.0 && cx > 0.0 && cy > 0.0; }
+  bool named() const { return !camera.empty() && camera != "info"; }
+  // Empty when consistent; otherwise says what is wrong (unknown name, partial fx..cy).
+  std::string problem() const;
+};
+
+struct CameraResult {
+  acvo::Camera camera;
+  std::string problem;
+};
+// Intrinsics of a width x height colour image: explicit override, else the named camera
+// (scaled when the image is not 640x480), else CameraInfo's K (whose size must match the image
+// and whose focal lengths must be positive).
+CameraResult cameraFor(const sensor_msgs::CameraInfo& info, int width, int height,
+                       const IntrinsicsOverride& override_intrinsics);
+
+// Optical-frame camera motion seen from a base frame rigidly attached to the camera:
+// T_base_cam * T * T_base_cam^-1.
+Eigen::Isometry3d conjugate(const Eigen::Isometry3d& base_from_cam, const Eigen::Isometry3d& t);
+
+// Twist (linear, angular) of a relative motion `delta` that took `dt` seconds, expressed in the
+// frame the motion starts from.
+struct Twist {
+  Eigen::Vector3d linear = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angular = Eigen::Vector3d::Zero();
+};
+Twist twistOf(const Eigen::Isometry3d& delta, double dt);
+
+geometry_msgs::Pose toPoseMsg(const Eigen::Isometry3d& pose);
+// The orientation is normalised; an all-zero quaternion is an error reported in `problem`.
+Eigen::Isometry3d fromPoseMsg(const geometry_msgs::Pose& pose, std::string* problem);
+
+geometry_msgs::TransformStamped toTransformMsg(const Eigen::Isometry3d& pose,
+                                               const std::string& parent,
+                                               const std::string& child, const ros::Time& stamp);
+
+// xyz (float32) + rgb (float32 holding 0x00RRGGBB, as rviz and PCL expect), unorganised, in the
+// camera frame of `header`.
+sensor_msgs::PointCloud2 toPointCloud2(const acvo::LabelledCloud& cloud,
+                                       const std_msgs::Header& header);
+
+}  // namespace acvo_ros

@@ -1,0 +1,138 @@
+#include "ros_params.hpp"
+
+#include <iomanip>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <type_traits>
+
+namespace acvo_ros {
+namespace {
+
+using XmlRpc::XmlRpcValue;
+
+std::string typeProblem(const std::string& key, const char* expected) {
+  return "~" + key + " must be " + expected + "; keeping its previous value";
+}
+
+std::string set(const std::string& key, const XmlRpcValue& v, int& field) {
+  if (v.getType() != XmlRpcValue::TypeInt) return typeProblem(key, "an integer");
+  field = static_cast<const int&>(v);
+  return {};
+}
+
+std::string set(const std::string& key, const XmlRpcValue& v, double& field) {
+  if (v.getType() == XmlRpcValue::TypeDouble) {
+    field = static_cast<const double&>(v);
+  } else if (v.getType() == XmlRpcValue::TypeInt) {
+    field = static_cast<const int&>(v);
+  } else {
+    return typeProblem(key, "a number");
+  }
+  return {};
+}
+
+std::string set(const std::string& key, const XmlRpcValue& v, bool& field) {
+  if (v.getType() != XmlRpcValue::TypeBoolean) return typeProblem(key, "true or false");
+  field = static_cast<const bool&>(v);
+  return {};
+}
+
+// The enums: a string parsed by the core's fromString.
+template <typename Enum>
+std::string set(const std::string& key, const XmlRpcValue& v, Enum& field) {
+  if (v.getType() != XmlRpcValue::TypeString) return typeProblem(key, "a string");
+  try {
+    Enum parsed = field;
+    acvo::fromString(static_cast<const std::string&>(v), parsed);
+    field = parsed;
+  } catch (const std::exception& e) {
+    return "~" + key + ": " + e.what() + "; keeping its previous value";
+  }
+  return {};
+}
+
+}  // namespace
+
+std::vector<std::string> applyRosParams(const XmlRpc::XmlRpcValue& private_ns,
+                                        acvo::Params& params) {
+  std::vector<std::string> problems;
+  if (private_ns.getType() != XmlRpcValue::TypeStruct) return problems;
+  std::set<std::string> known;
+  visitParams(params, [&](const std::string& section, const std::string& name, auto& field) {
+    known.insert(section + "/" + name);
+    if (!private_ns.hasMember(section)) return;
+    const XmlRpcValue& values = private_ns[section];
+    if (values.getType() != XmlRpcValue::TypeStruct || !values.hasMember(name)) return;
+    std::string problem = set(section + "/" + name, values[name], field);
+    if (!problem.empty()) problems.push_back(problem);
+  });
+  for (const char* section : {"selection", "solver", "odometry"}) {
+    if (!private_ns.hasMember(section)) continue;
+    const XmlRpcValue& values = private_ns[section];
+    if (values.getType() != XmlRpcValue::TypeStruct) {
+      problems.push_back(std::string("~") + section + " must be a dictionary of parameters");
+      continue;
+    }
+    for (const auto& kv : values) {
+      if (!known.count(std::string(section) + "/" + kv.first)) {
+        problems.push_back(std::string("unknown parameter ~") + section + "/" + kv.first +
+                           " (ignored)");
+      }
+    }
+  }
+  return problems;
+}
+
+std::string describeParams(const acvo::Params& params) {
+  std::ostringstream out;
+  out << std::setprecision(17);
+  const char* separator = "";
+  visitParams(params, [&](const std::string& section, const std::string& name, const auto& v) {
+    out << separator << section << '/' << name << '=';
+    using T = std::decay_t<decltype(v)>;
+    if constexpr (std::is_same_v<T, bool>) {
+      out << (v ? "true" : "false");
+    } else if constexpr (std::is_arithmetic_v<T>) {
+      out << v;
+    } else {
+      out << acvo::toString(v);
+    }
+    separator = " ";
+  });
+  return out.str();
+}
+
+acvo::AcvoConfig toConfig(const acvo::Params& params, bool publish_null_when_lost) {
+  acvo::AcvoConfig c = acvo::AcvoConfig::__getDefault__();
+  c.target_points = params.selection.target_points;
+  c.min_depth = params.selection.min_depth;
+  c.max_depth = params.selection.max_depth;
+  c.ell_policy = acvo::toString(params.solver.ell_policy);
+  c.ell_init = params.solver.ell_init;
+  c.ell_min = params.solver.ell_min;
+  c.ell_max = params.solver.ell_max;
+  c.color_ell = params.solver.color_ell;
+  c.sparsification = params.solver.sparsification;
+  c.max_iterations = params.solver.max_iterations;
+  c.initial_guess = acvo::toString(params.odometry.initial_guess);
+  c.publish_null_when_lost = publish_null_when_lost;
+  return c;
+}
+
+acvo::Params fromConfig(const acvo::AcvoConfig& config, acvo::Params base) {
+  base.selection.target_points = config.target_points;
+  base.selection.min_depth = config.min_depth;
+  base.selection.max_depth = config.max_depth;
+  acvo::fromString(config.ell_policy, base.solver.ell_policy);
+  base.solver.ell_init = config.ell_init;
+  base.solver.ell_min = config.ell_min;
+  base.solver.ell_max = config.ell_max;
+  base.solver.color_ell = config.color_ell;
+  base.solver.sparsification = config.sparsification;
+  base.solver.max_iterations = config.max_iterations;
+  acvo::fromString(config.initial_guess, base.odometry.initial_guess);
+  return base;
+}
+
+}  // namespace acvo_ros

@@ -1,0 +1,33 @@
+// acvo::Params from the ROS parameter server and from dynamic_reconfigure.
+//
+// The private namespace holds the same sections and keys as config/acvo.yaml
+// (~selection/target_points, ~solver/ell_policy as a string, ...): the nodelet walks
+// acvo::visitParams, so a key added to the core is read here without a change.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <xmlrpcpp/XmlRpcValue.h>
+
+#include "acvo/AcvoConfig.h"
+#include "acvo/params.hpp"
+
+namespace acvo_ros {
+
+// Applies the sections of `private_ns` (the struct of the node's private namespace) on top of
+// `params`. Returns one sentence per problem: a wrong type or unknown enum value (that key
+// keeps its previous value) or an unknown key in a section (ignored). Does not validate().
+std::vector<std::string> applyRosParams(const XmlRpc::XmlRpcValue& private_ns,
+                                        acvo::Params& params);
+
+// "section/name=value ..." for every parameter: logged at start and compared to detect a change.
+std::string describeParams(const acvo::Params& params);
+
+// The dynamic_reconfigure view of the parameters it exposes.
+acvo::AcvoConfig toConfig(const acvo::Params& params, bool publish_null_when_lost);
+// The parameters with the reconfigurable ones taken from `config`. Throws
+// std::invalid_argument for an unknown enum string.
+acvo::Params fromConfig(const acvo::AcvoConfig& config, acvo::Params base);
+
+}  // namespace acvo_ros
