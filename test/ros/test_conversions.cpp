@@ -1,0 +1,343 @@
+// The nodelet's message conversions, covariance model, stamp rules and parameter loading,
+// without a ROS master.
+#include <cmath>
+#include <cstring>
+
+#include <gtest/gtest.h>
+#include <sensor_msgs/image_encodings.h>
+
+#include "conversions.hpp"
+#include "covariance.hpp"
+#include "ros_params.hpp"
+#include "stamp_check.hpp"
+
+namespace acvo_ros {
+namespace {
+namespace enc = sensor_msgs::image_encodings;
+
+sensor_msgs::Image image(const std::string& encoding, int w, int h, int bytes_per_pixel) {
+  sensor_msgs::Image m;
+  m.encoding = encoding;
+  m.width = w;
+  m.height = h;
+  m.step = w * bytes_per_pixel;
+  m.data.assign(m.step * h, 0);
+  return m;
+}
+
+sensor_msgs::CameraInfo info(double fx, double fy, double cx, double cy, int w, int h) {
+  sensor_msgs::CameraInfo i;
+  i.K = {fx, 0, cx, 0, fy, cy, 0, 0, 1};
+  i.width = w;
+  i.height = h;
+  return i;
+}
+
+TEST(StripSlash, RemovesLeadingSlashesOnly) {
+  EXPECT_EQ(stripSlash("/openni_rgb_optical_frame"), "openni_rgb_optical_frame");
+  EXPECT_EQ(stripSlash("//a/b"), "a/b");
+  EXPECT_EQ(stripSlash("odom"), "odom");
+  EXPECT_EQ(stripSlash(""), "");
+}
+
+TEST(DecodeColor, KeepsChannelOrderOfEachEncoding) {
+  // One pixel with R=10, G=20, B=30 in every encoding.
+  struct Case {
+    std::string encoding;
+    std::vector<std::uint8_t> bytes;
+    acvo::ColorOrder order;
+    std::vector<std::uint8_t> expected;  // the decoded pixel's channels
+  };
+  const std::vector<Case> cases = {
+      {enc::RGB8, {10, 20, 30}, acvo::ColorOrder::kRgb, {10, 20, 30}},
+      {enc::BGR8, {30, 20, 10}, acvo::ColorOrder::kBgr, {30, 20, 10}},
+      {enc::RGBA8, {10, 20, 30, 255}, acvo::ColorOrder::kRgb, {10, 20, 30}},
+      {enc::BGRA8, {30, 20, 10, 255}, acvo::ColorOrder::kBgr, {30, 20, 10}},
+      {enc::MONO8, {77}, acvo::ColorOrder::kGray, {77}},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.encoding);
+    sensor_msgs::Image m = image(c.encoding, 1, 1, static_cast<int>(c.bytes.size()));
+    m.data = c.bytes;
+    const ColorImage out = decodeColor(m);
+    ASSERT_EQ(out.problem, "");
+    EXPECT_EQ(out.order, c.order);
+    ASSERT_EQ(out.image.channels(), static_cast<int>(c.expected.size()));
+    for (std::size_t k = 0; k < c.expected.size(); ++k) {
+      EXPECT_EQ(out.image.ptr<std::uint8_t>(0)[k], c.expected[k]);
+    }
+  }
+}
+
+TEST(DecodeColor, NamesAnUnsupportedEncoding) {
+  const ColorImage out = decodeColor(image(enc::YUV422, 4, 2, 2));
+  EXPECT_NE(out.problem.find("'yuv422'"), std::string::npos) << out.problem;
+  EXPECT_TRUE(out.image.empty());
+}
+
+TEST(DecodeColor, RejectsTruncatedDataAndShortStep) {
+  sensor_msgs::Image m = image(enc::RGB8, 4, 3, 3);
+  m.data.resize(m.data.size() - 1);
+  EXPECT_NE(decodeColor(m).problem.find("truncated"), std::string::npos);
+  m = image(enc::RGB8, 4, 3, 3);
+  m.step = 11;
+  EXPECT_NE(decodeColor(m).problem.find("step 11"), std::string::npos);
+  EXPECT_NE(decodeColor(image(enc::RGB8, 0, 3, 3)).problem, "");
+}
+
+TEST(DecodeColor, HonoursRowPadding) {
+  sensor_msgs::Image m = image(enc::MONO8, 2, 2, 1);
+  m.step = 4;
+  m.data = {1, 2, 99, 99, 3, 4, 99, 99};
+  const ColorImage out = decodeColor(m);
+  ASSERT_EQ(out.problem, "");
+  EXPECT_EQ(out.image.at<std::uint8_t>(1, 0), 3);
+  EXPECT_EQ(out.image.at<std::uint8_t>(1, 1), 4);
+}
+
+TEST(DecodeDepth, MillimetresAndMetresGiveTheSameMetres) {
+  sensor_msgs::Image mm = image(enc::TYPE_16UC1, 3, 1, 2);
+  const std::uint16_t raw[3] = {1500, 0, 65535};
+  std::memcpy(mm.data.data(), raw, sizeof raw);
+  const DepthImage a = decodeDepth(mm);
+  ASSERT_EQ(a.problem, "");
+  EXPECT_DOUBLE_EQ(a.units_per_metre, 1000.0);
+  EXPECT_FLOAT_EQ(a.metres.at<float>(0, 0), 1.5f);
+  EXPECT_EQ(a.metres.at<float>(0, 1), 0.0f);
+  EXPECT_FLOAT_EQ(a.metres.at<float>(0, 2), 65.535f);
+
+  sensor_msgs::Image m = image(enc::TYPE_32FC1, 3, 1, 4);
+  const float raw_m[3] = {1.5f, std::nanf(""), -1.0f};
+  std::memcpy(m.data.data(), raw_m, sizeof raw_m);
+  const DepthImage b = decodeDepth(m);
+  ASSERT_EQ(b.problem, "");
+  EXPECT_FLOAT_EQ(b.metres.at<float>(0, 0), 1.5f);
+  EXPECT_EQ(b.metres.at<float>(0, 1), 0.0f);  // NaN is invalid
+  EXPECT_EQ(b.metres.at<float>(0, 2), 0.0f);  // negative is invalid
+}
+
+TEST(DecodeDepth, NamesAnUnsupportedEncodingAndForeignByteOrder) {
+  EXPECT_NE(decodeDepth(image(enc::TYPE_8UC1, 2, 2, 1)).problem.find("'8UC1'"), std::string::npos);
+  sensor_msgs::Image m = image(enc::TYPE_16UC1, 2, 2, 2);
+  m.is_bigendian = 1;  // this test machine is little-endian (x86 / arm64)
+  EXPECT_NE(decodeDepth(m).problem.find("byte order"), std::string::npos);
+}
+
+TEST(CameraFor, UsesCameraInfoAndChecksIt) {
+  const CameraResult ok = cameraFor(info(500, 510, 320, 240, 640, 480), 640, 480, {});
+  ASSERT_EQ(ok.problem, "");
+  EXPECT_DOUBLE_EQ(ok.camera.fx, 500);
+  EXPECT_DOUBLE_EQ(ok.camera.fy, 510);
+  EXPECT_DOUBLE_EQ(ok.camera.cx, 320);
+  EXPECT_DOUBLE_EQ(ok.camera.cy, 240);
+  EXPECT_TRUE(ok.camera.valid());
+  EXPECT_NE(cameraFor(info(0, 510, 320, 240, 640, 480), 640, 480, {}).problem.find("focal"),
+            std::string::npos);
+  EXPECT_NE(cameraFor(info(500, 510, 320, 240, 320, 240), 640, 480, {}).problem.find("320x240"),
+            std::string::npos);
+}
+
+TEST(CameraFor, OverridesWinOverCameraInfo) {
+  const sensor_msgs::CameraInfo zero = info(0, 0, 0, 0, 0, 0);  // ignored when overridden
+  IntrinsicsOverride named;
+  named.camera = "fr1";
+  const CameraResult fr1 = cameraFor(zero, 640, 480, named);
+  ASSERT_EQ(fr1.problem, "");
+  EXPECT_DOUBLE_EQ(fr1.camera.fx, 517.3);
+  EXPECT_DOUBLE_EQ(fr1.camera.cy, 255.3);
+  const CameraResult half = cameraFor(zero, 320, 240, named);
+  EXPECT_DOUBLE_EQ(half.camera.fx, 517.3 / 2);
+  EXPECT_DOUBLE_EQ(half.camera.cy, 255.3 / 2);
+
+  IntrinsicsOverride values;
+  values.fx = 400;
+  values.fy = 401;
+  values.cx = 300;
+  values.cy = 200;
+  const CameraResult v = cameraFor(zero, 640, 480, values);
+  ASSERT_EQ(v.problem, "");
+  EXPECT_DOUBLE_EQ(v.camera.fy, 401);
+
+  IntrinsicsOverride partial;
+  partial.fx = 400;
+  EXPECT_NE(partial.problem(), "");
+  IntrinsicsOverride unknown;
+  unknown.camera = "fr9";
+  EXPECT_NE(unknown.problem().find("fr9"), std::string::npos);
+  IntrinsicsOverride info_name;
+  info_name.camera = "info";
+  EXPECT_EQ(info_name.problem(), "");
+  EXPECT_FALSE(info_name.named());
+}
+
+Eigen::Isometry3d pose(double rx, double ry, double rz, double x, double y, double z) {
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  t.linear() = (Eigen::AngleAxisd(rz, Eigen::Vector3d::UnitZ()) *
+                Eigen::AngleAxisd(ry, Eigen::Vector3d::UnitY()) *
+                Eigen::AngleAxisd(rx, Eigen::Vector3d::UnitX()))
+                   .matrix();
+  t.translation() << x, y, z;
+  return t;
+}
+
+TEST(Conjugate, OpticalForwardIsBaseForward) {
+  // REP 103 optical frame in a base frame: z_optical = x_base, x_optical = -y_base.
+  Eigen::Isometry3d base_from_optical = Eigen::Isometry3d::Identity();
+  base_from_optical.linear() << 0, 0, 1, -1, 0, 0, 0, -1, 0;
+  base_from_optical.translation() << 0.1, 0.0, 0.3;
+  Eigen::Isometry3d forward = Eigen::Isometry3d::Identity();
+  forward.translation() << 0, 0, 1;  // 1 m along the optical axis
+  const Eigen::Isometry3d base_motion = conjugate(base_from_optical, forward);
+  EXPECT_TRUE(base_motion.translation().isApprox(Eigen::Vector3d(1, 0, 0), 1e-12));
+  EXPECT_TRUE(base_motion.rotation().isApprox(Eigen::Matrix3d::Identity(), 1e-12));
+  // A yaw of the camera about its own y (down) axis is a yaw of the base about -z.
+  const Eigen::Isometry3d yaw = conjugate(base_from_optical, pose(0, 0.1, 0, 0, 0, 0));
+  EXPECT_NEAR(Eigen::AngleAxisd(yaw.rotation()).angle(), 0.1, 1e-12);
+  EXPECT_TRUE(Eigen::AngleAxisd(yaw.rotation()).axis().isApprox(Eigen::Vector3d(0, 0, -1), 1e-9));
+}
+
+TEST(TwistOf, IsMotionOverTime) {
+  const Twist t = twistOf(pose(0, 0, 0.2, 0.3, 0, 0), 0.1);
+  EXPECT_TRUE(t.linear.isApprox(Eigen::Vector3d(3, 0, 0), 1e-12));
+  EXPECT_TRUE(t.angular.isApprox(Eigen::Vector3d(0, 0, 2), 1e-12));
+  EXPECT_TRUE(twistOf(pose(0, 0, 0.2, 0.3, 0, 0), 0.0).linear.isZero());
+}
+
+TEST(PoseMsg, RoundTripsAndRejectsZeroQuaternion) {
+  const Eigen::Isometry3d p = pose(0.1, -0.2, 0.3, 1, 2, 3);
+  std::string problem = "stale";
+  EXPECT_TRUE(fromPoseMsg(toPoseMsg(p), &problem).isApprox(p, 1e-12));
+  EXPECT_EQ(problem, "");
+  geometry_msgs::Pose zero;
+  fromPoseMsg(zero, &problem);
+  EXPECT_NE(problem, "");
+}
+
+TEST(PointCloud2, PacksXyzAndRgb) {
+  acvo::LabelledCloud cloud;
+  cloud.points = {{1.f, 2.f, 3.f}, {-1.f, 0.5f, 4.f}};
+  cloud.rgb = {{{255, 128, 1}}, {{0, 0, 0}}};
+  std_msgs::Header h;
+  h.frame_id = "cam";
+  const sensor_msgs::PointCloud2 msg = toPointCloud2(cloud, h);
+  ASSERT_EQ(msg.width, 2u);
+  ASSERT_EQ(msg.fields.size(), 4u);
+  EXPECT_EQ(msg.fields[3].name, "rgb");
+  EXPECT_EQ(msg.header.frame_id, "cam");
+  float v[4];
+  std::memcpy(v, &msg.data[msg.point_step], sizeof v);
+  EXPECT_EQ(v[0], -1.f);
+  EXPECT_EQ(v[2], 4.f);
+  std::uint32_t rgb = 0;
+  std::memcpy(&rgb, &msg.data[12], 4);
+  EXPECT_EQ(rgb, 0xff8001u);
+}
+
+TEST(Covariance, ReordersRotationFirstToRosOrder) {
+  Covariance6 c = Covariance6::Zero();
+  c.diagonal() << 1, 2, 3, 4, 5, 6;  // rotation x y z, translation x y z
+  c(0, 3) = c(3, 0) = 0.5;           // rot x with trans x
+  const Covariance6 ros = toRosOrder(c);
+  Eigen::Matrix<double, 6, 1> expected;
+  expected << 4, 5, 6, 1, 2, 3;
+  EXPECT_TRUE(ros.diagonal().isApprox(expected));
+  EXPECT_EQ(ros(3, 0), 0.5);
+}
+
+TEST(Covariance, AccumulatesRotatedRelativeCovariances) {
+  Covariance6 rel = Covariance6::Zero();
+  rel.diagonal() << 1e-4, 0, 0, 0, 0, 0;  // along the camera's x only
+  const Eigen::Matrix3d quarter_turn =
+      Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).matrix();
+  Covariance6 pose_cov = originCovariance();
+  pose_cov = accumulate(pose_cov, rel, Eigen::Matrix3d::Identity());
+  pose_cov = accumulate(pose_cov, rel, quarter_turn);  // camera x is odom y now
+  EXPECT_NEAR(pose_cov(0, 0), 1e-4 + kOriginVariance, 1e-15);
+  EXPECT_NEAR(pose_cov(1, 1), 1e-4 + kOriginVariance, 1e-15);
+  EXPECT_NEAR(pose_cov(2, 2), kOriginVariance, 1e-15);
+  // A matrix the engine could not fill is treated as unknown motion.
+  Covariance6 bad = rel;
+  bad(1, 1) = std::nan("");
+  EXPECT_GE(accumulate(pose_cov, bad, Eigen::Matrix3d::Identity())(2, 2), kLostVariance);
+  EXPECT_TRUE(sanitise(rel).isApprox(rel));
+}
+
+TEST(StampCheck, DropsRepeatsRestartsOnJumpBackWarnsOnGaps) {
+  EXPECT_EQ(checkStamp(0.0, 100.0, 1.0), StampVerdict::kAccept);
+  EXPECT_EQ(checkStamp(100.0, 100.033, 1.0), StampVerdict::kAccept);
+  EXPECT_EQ(checkStamp(100.0, 100.0, 1.0), StampVerdict::kDrop);
+  EXPECT_EQ(checkStamp(100.0, 99.5, 1.0), StampVerdict::kDrop);
+  EXPECT_EQ(checkStamp(100.0, 98.0, 1.0), StampVerdict::kRestart);
+  EXPECT_EQ(checkStamp(100.0, 101.5, 1.0), StampVerdict::kGap);
+  EXPECT_EQ(checkStamp(100.0, 101.5, 2.0), StampVerdict::kAccept);
+}
+
+XmlRpc::XmlRpcValue section(const std::string& key, const XmlRpc::XmlRpcValue& value) {
+  XmlRpc::XmlRpcValue s;
+  s[key] = value;
+  return s;
+}
+
+TEST(RosParams, ReadsEverySectionWithCoreNamesAndReportsProblems) {
+  XmlRpc::XmlRpcValue ns;
+  ns["selection"] = section("target_points", 1234);
+  ns["selection"]["max_depth"] = 4;  // an integer is fine for a double
+  ns["solver"] = section("ell_policy", std::string(acvo::toString(acvo::EllPolicy::kFixedSchedule)));
+  ns["solver"]["max_iterations"] = 2.5;  // wrong type: reported, default kept
+  ns["solver"]["no_such_key"] = 1;
+  ns["odometry"] = section("initial_guess", std::string("sideways"));
+  ns["approx_sync"] = true;  // a nodelet setting, not an algorithm parameter
+  acvo::Params p;
+  const std::vector<std::string> problems = applyRosParams(ns, p);
+  EXPECT_EQ(p.selection.target_points, 1234);
+  EXPECT_DOUBLE_EQ(p.selection.max_depth, 4.0);
+  EXPECT_EQ(p.solver.ell_policy, acvo::EllPolicy::kFixedSchedule);
+  EXPECT_EQ(p.solver.max_iterations, acvo::Params().solver.max_iterations);
+  EXPECT_EQ(p.odometry.initial_guess, acvo::Params().odometry.initial_guess);
+  ASSERT_EQ(problems.size(), 3u);
+  std::string all;
+  for (const auto& s : problems) all += s + "\n";
+  EXPECT_NE(all.find("~solver/max_iterations"), std::string::npos) << all;
+  EXPECT_NE(all.find("~odometry/initial_guess"), std::string::npos) << all;
+  EXPECT_NE(all.find("~solver/no_such_key"), std::string::npos) << all;
+}
+
+TEST(RosParams, ReconfigureRoundTripsAndDescribesEveryParameter) {
+  acvo::Params p;
+  p.selection.target_points = 777;
+  p.solver.ell_policy = acvo::EllPolicy::kFixedSchedule;
+  p.odometry.initial_guess = acvo::InitialGuess::kIdentity;
+  p.solver.sparsification = 1e-3;
+  const acvo::AcvoConfig c = toConfig(p, true);
+  EXPECT_TRUE(c.publish_null_when_lost);
+  const acvo::Params back = fromConfig(c, acvo::Params());
+  EXPECT_EQ(describeParams(back), describeParams(p));
+  EXPECT_NE(describeParams(p).find("selection/target_points=777"), std::string::npos);
+  int count = 0;
+  acvo::Params q;
+  acvo::visitParams(q, [&](const std::string&, const std::string&, auto&) { ++count; });
+  const std::string d = describeParams(q);
+  EXPECT_EQ(std::count(d.begin(), d.end(), '='), count);
+}
+
+TEST(RosParams, EveryReconfigureEnumValueIsAcceptedByTheCore) {
+  // The .cfg lists the enum strings; they must be the core's own spellings.
+  for (const auto& v : {acvo::EllPolicy::kAdaptive, acvo::EllPolicy::kFixedSchedule}) {
+    acvo::AcvoConfig c = toConfig(acvo::Params(), false);
+    c.ell_policy = acvo::toString(v);
+    EXPECT_EQ(fromConfig(c, acvo::Params()).solver.ell_policy, v);
+  }
+  acvo::AcvoConfig c = acvo::AcvoConfig::__getDefault__();
+  EXPECT_NO_THROW(fromConfig(c, acvo::Params()));
+  for (const char* name : {"adaptive", "fixed_schedule"}) {
+    acvo::EllPolicy v;
+    EXPECT_NO_THROW(acvo::fromString(name, v)) << name;
+  }
+  for (const char* name : {"constant_velocity", "identity"}) {
+    acvo::InitialGuess v;
+    EXPECT_NO_THROW(acvo::fromString(name, v)) << name;
+  }
+}
+
+}  // namespace
+}  // namespace acvo_ros

@@ -1,0 +1,561 @@
+// Synthetic RGB-D frames with known motion through the odometry nodelet (rostest + gtest).
+//
+// The .test file starts the nodelet with the camera topics remapped to cam/*, and sets the
+// private parameters of this test: depth_encoding, color_encoding, approx (depth stamps offset
+// from colour stamps), camera_frame (as sent, may carry a leading '/'), odom_frame and
+// base_frame (expected ids), base_from_camera ("x y z qx qy qz qw" of the static transform the
+// .test publishes; empty = base is the optical frame), exact_stamps (run the stamp tests, which
+// need exact synchronisation: the approximate policy itself swallows reordered stamps).
+#include <cmath>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <sstream>
+
+#include <diagnostic_msgs/DiagnosticArray.h>
+#include <gtest/gtest.h>
+#include <nav_msgs/Odometry.h>
+#include <ros/ros.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <std_srvs/Empty.h>
+#include <tf2_eigen/tf2_eigen.h>
+#include <tf2_ros/transform_listener.h>
+
+#include "acvo/OdometryInfo.h"
+#include "acvo/ResetToPose.h"
+#include "conversions.hpp"
+#include "covariance.hpp"
+#include "synthetic_room.hpp"
+#include "test_messages.hpp"
+
+namespace {
+
+using acvo_test::cameraPose;
+using acvo_test::RgbdImage;
+
+// Pose error after kTrackFrames frames of 1.5 cm / 0.6 deg each (0.17 m, 6.6 deg in all).
+// Measured on the synthetic room (see docs/ros.md); the bounds leave about 3x margin.
+constexpr int kTrackFrames = 12;
+constexpr double kTranslationTolerance = 0.02;  // m
+constexpr double kRotationTolerance = 0.02;     // rad
+constexpr double kOutcomeTimeout = 20.0;        // s, one frame through a loaded machine
+
+double angleOf(const Eigen::Matrix3d& r) { return Eigen::AngleAxisd(r).angle(); }
+
+Eigen::Isometry3d toEigen(const geometry_msgs::Pose& p) {
+  Eigen::Isometry3d t;
+  tf2::fromMsg(p, t);
+  return t;
+}
+
+struct Outcome {
+  std::optional<acvo::OdometryInfo> info;
+  std::optional<nav_msgs::Odometry> odom;
+};
+
+// Everything the test sends and receives, shared by the test cases (one nodelet per .test).
+class Client {
+ public:
+  Client() : pnh_("~"), tf_listener_(tf_buffer_) {
+    depth_encoding_ = pnh_.param<std::string>("depth_encoding", "32FC1");
+    color_encoding_ = pnh_.param<std::string>("color_encoding", "rgb8");
+    approx_ = pnh_.param("approx", true);
+    camera_frame_ = pnh_.param<std::string>("camera_frame", "cam_rgb_optical_frame");
+    odom_frame_ = pnh_.param<std::string>("odom_frame", "odom");
+    base_frame_ = pnh_.param<std::string>("base_frame", acvo_ros::stripSlash(camera_frame_));
+    exact_stamps_ = pnh_.param("exact_stamps", false);
+    base_from_camera_ = Eigen::Isometry3d::Identity();
+    std::istringstream tf(pnh_.param<std::string>("base_from_camera", ""));
+    double x, y, z, qx, qy, qz, qw;
+    if (tf >> x >> y >> z >> qx >> qy >> qz >> qw) {
+      base_from_camera_.linear() = Eigen::Quaterniond(qw, qx, qy, qz).normalized().matrix();
+      base_from_camera_.translation() << x, y, z;
+    }
+    rgb_pub_ = nh_.advertise<sensor_msgs::Image>("cam/rgb", 20);
+    depth_pub_ = nh_.advertise<sensor_msgs::Image>("cam/depth", 20);
+    info_pub_ = nh_.advertise<sensor_msgs::CameraInfo>("cam/info", 20);
+    odom_sub_ = nh_.subscribe("odom", 100, &Client::onOdom, this);
+    info_sub_ = nh_.subscribe("odom_info", 100, &Client::onInfo, this);
+    diag_sub_ = nh_.subscribe("/diagnostics", 100, &Client::onDiagnostics, this);
+    reset_ = nh_.serviceClient<std_srvs::Empty>("reset_odom");
+    reset_to_pose_ = nh_.serviceClient<acvo::ResetToPose>("reset_odom_to_pose");
+    next_stamp_ = ros::Time::now();
+  }
+
+  // Waits until the nodelet is connected both ways.
+  bool connect() {
+    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(60.0);
+    while (ros::WallTime::now() < deadline) {
+      if (rgb_pub_.getNumSubscribers() > 0 && depth_pub_.getNumSubscribers() > 0 &&
+          info_pub_.getNumSubscribers() > 0 && odom_sub_.getNumPublishers() > 0 &&
+          info_sub_.getNumPublishers() > 0 && reset_.exists()) {
+        return true;
+      }
+      ros::WallDuration(0.05).sleep();
+    }
+    return false;
+  }
+
+  ros::Time nextStamp() {
+    next_stamp_ += ros::Duration(0.1);
+    return next_stamp_;
+  }
+
+  // Publishes one frame; `mutate` may spoil any of the three messages.
+  template <typename Mutate>
+  void send(const RgbdImage& img, const ros::Time& stamp, Mutate&& mutate) {
+    std_msgs::Header h;
+    h.stamp = stamp;
+    h.frame_id = camera_frame_;
+    std_msgs::Header dh = h;
+    if (approx_) dh.stamp += ros::Duration(0.007);  // like TUM: depth a few ms after colour
+    sensor_msgs::ImagePtr rgb = acvo_test::colorMsg(img.rgb, color_encoding_, h);
+    sensor_msgs::ImagePtr depth = acvo_test::depthMsg(img.depth, depth_encoding_, dh);
+    sensor_msgs::CameraInfoPtr info = acvo_test::infoMsg(acvo_test::testCamera(), h);
+    mutate(*rgb, *depth, *info);
+    info_pub_.publish(info);
+    depth_pub_.publish(depth);
+    rgb_pub_.publish(rgb);
+  }
+  void send(const RgbdImage& img, const ros::Time& stamp) {
+    send(img, stamp, [](auto&, auto&, auto&) {});
+  }
+
+  // The approximate policy holds a set back until a later message proves it the best match:
+  // a later colour image and camera info (no depth, so no frame) release it.
+  void flush() {
+    if (!approx_) return;
+    std_msgs::Header h;
+    h.stamp = nextStamp();
+    h.frame_id = camera_frame_;
+    info_pub_.publish(acvo_test::infoMsg(acvo_test::testCamera(), h));
+    rgb_pub_.publish(acvo_test::colorMsg(frame(0).rgb, color_encoding_, h));
+  }
+
+  // Waits for what the nodelet said about the frame stamped `stamp`. `expect_odom`: also wait
+  // for the odometry message (otherwise give it a moment to show that none comes).
+  Outcome outcome(const ros::Time& stamp, bool expect_odom, double timeout = kOutcomeTimeout) {
+    Outcome out;
+    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(timeout);
+    while (ros::WallTime::now() < deadline && !(out.info = infoAt(stamp))) {
+      ros::WallDuration(0.002).sleep();
+    }
+    if (!out.info) return out;
+    const ros::WallTime odom_deadline = ros::WallTime::now() + ros::WallDuration(expect_odom ? 2.0 : 0.3);
+    while (ros::WallTime::now() < odom_deadline && !(out.odom = odomAt(stamp))) {
+      ros::WallDuration(0.002).sleep();
+    }
+    return out;
+  }
+
+  // Sends frames k in `indices` (rendered once and cached) and returns their outcomes, keeping
+  // one frame in flight so the approximate policy can release each set.
+  std::vector<Outcome> run(const std::vector<int>& indices, std::vector<ros::Time>* stamps = nullptr) {
+    std::vector<ros::Time> sent;
+    std::vector<Outcome> out;
+    for (std::size_t i = 0; i < indices.size(); ++i) {
+      sent.push_back(nextStamp());
+      send(frame(indices[i]), sent.back());
+      if (i > 0) out.push_back(outcome(sent[i - 1], true));
+    }
+    flush();
+    out.push_back(outcome(sent.back(), true));
+    if (stamps) *stamps = sent;
+    return out;
+  }
+
+  const RgbdImage& frame(int k) {
+    auto it = frames_.find(k);
+    if (it == frames_.end()) {
+      it = frames_
+               .emplace(k, acvo_test::renderRoom(
+                               acvo_test::worldFromFirstCamera() * cameraPose(k),
+                               acvo_test::testCamera()))
+               .first;
+    }
+    return it->second;
+  }
+  // All depth invalid.
+  RgbdImage blank() {
+    RgbdImage img = frame(0);
+    RgbdImage out{img.rgb.clone(), cv::Mat::zeros(img.depth.size(), CV_32FC1)};
+    return out;
+  }
+
+  bool reset() {
+    std_srvs::Empty srv;
+    return reset_.call(srv);
+  }
+  std::optional<acvo::ResetToPose::Response> resetTo(const Eigen::Isometry3d& pose) {
+    acvo::ResetToPose srv;
+    srv.request.pose = tf2::toMsg(pose);
+    if (!reset_to_pose_.call(srv)) return std::nullopt;
+    return srv.response;
+  }
+
+  // Expected published pose of camera pose `cam` (base frame conjugation).
+  Eigen::Isometry3d expectedBase(const Eigen::Isometry3d& cam) const {
+    return acvo_ros::conjugate(base_from_camera_, cam);
+  }
+
+  // The newest odometry diagnostic received after `after` (wall), if any.
+  std::optional<diagnostic_msgs::DiagnosticStatus> diagnosticAfter(const ros::WallTime& after) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!last_diag_ || last_diag_wall_ < after) return std::nullopt;
+    return last_diag_;
+  }
+  std::optional<diagnostic_msgs::DiagnosticStatus> waitDiagnostic(std::uint8_t level,
+                                                                  double timeout = 5.0) {
+    const ros::WallTime start = ros::WallTime::now();
+    std::optional<diagnostic_msgs::DiagnosticStatus> d;
+    while ((ros::WallTime::now() - start).toSec() < timeout) {
+      d = diagnosticAfter(start);
+      if (d && d->level == level) return d;
+      ros::WallDuration(0.05).sleep();
+    }
+    return d;
+  }
+
+  std::optional<geometry_msgs::TransformStamped> lookup(const ros::Time& stamp) {
+    try {
+      return tf_buffer_.lookupTransform(odom_frame_, base_frame_, stamp, ros::Duration(2.0));
+    } catch (const tf2::TransformException&) {
+      return std::nullopt;
+    }
+  }
+
+  int infoCount(const ros::Time& t) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return info_counts_[t];
+  }
+
+  ros::NodeHandle nh_, pnh_;
+  std::string depth_encoding_, color_encoding_, camera_frame_, odom_frame_, base_frame_;
+  bool approx_ = true, exact_stamps_ = false;
+  Eigen::Isometry3d base_from_camera_;
+  ros::Publisher rgb_pub_, depth_pub_, info_pub_;
+  ros::Subscriber odom_sub_, info_sub_, diag_sub_;
+  ros::ServiceClient reset_, reset_to_pose_;
+
+ private:
+  void onOdom(const nav_msgs::Odometry& m) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    odoms_[m.header.stamp] = m;
+  }
+  void onInfo(const acvo::OdometryInfo& m) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    infos_[m.header.stamp] = m;
+    ++info_counts_[m.header.stamp];
+  }
+  void onDiagnostics(const diagnostic_msgs::DiagnosticArray& a) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const auto& s : a.status) {
+      if (s.name.find("odometry") != std::string::npos) {
+        last_diag_ = s;
+        last_diag_wall_ = ros::WallTime::now();
+      }
+    }
+  }
+  std::optional<acvo::OdometryInfo> infoAt(const ros::Time& t) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto it = infos_.find(t);
+    if (it == infos_.end()) return std::nullopt;
+    return it->second;
+  }
+  std::optional<nav_msgs::Odometry> odomAt(const ros::Time& t) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto it = odoms_.find(t);
+    if (it == odoms_.end()) return std::nullopt;
+    return it->second;
+  }
+
+  tf2_ros::Buffer tf_buffer_;
+  tf2_ros::TransformListener tf_listener_;
+  std::mutex mutex_;
+  std::map<ros::Time, nav_msgs::Odometry> odoms_;
+  std::map<ros::Time, acvo::OdometryInfo> infos_;
+  std::map<ros::Time, int> info_counts_;
+  std::optional<diagnostic_msgs::DiagnosticStatus> last_diag_;
+  ros::WallTime last_diag_wall_;
+  std::map<int, RgbdImage> frames_;
+  ros::Time next_stamp_;
+};
+
+Client* client = nullptr;
+
+std::vector<int> range(int from, int to) {
+  std::vector<int> v;
+  for (int k = from; k < to; ++k) v.push_back(k);
+  return v;
+}
+
+void expectPoseNear(const geometry_msgs::Pose& got, const Eigen::Isometry3d& want,
+                    const std::string& what) {
+  const Eigen::Isometry3d g = toEigen(got);
+  const double dt = (g.translation() - want.translation()).norm();
+  const double dr = angleOf(g.rotation().transpose() * want.rotation());
+  EXPECT_LT(dt, kTranslationTolerance) << what << ": translation error " << dt << " m";
+  EXPECT_LT(dr, kRotationTolerance) << what << ": rotation error " << dr << " rad";
+  RecordProperty(what + "_translation_error_mm", static_cast<int>(std::lround(dt * 1000)));
+  std::cout << "[ MEASURED ] " << what << ": translation error " << dt << " m, rotation error "
+            << dr << " rad\n";
+}
+
+TEST(OdometryNodelet, TracksKnownMotionWithRightFramesCovarianceAndTf) {
+  ASSERT_TRUE(client->reset());
+  std::vector<ros::Time> stamps;
+  const std::vector<Outcome> out = client->run(range(0, kTrackFrames), &stamps);
+  ASSERT_EQ(out.size(), static_cast<std::size_t>(kTrackFrames));
+  double last_variance = 0.0;
+  for (int k = 0; k < kTrackFrames; ++k) {
+    SCOPED_TRACE("frame " + std::to_string(k));
+    ASSERT_TRUE(out[k].info) << "no odom_info";
+    ASSERT_TRUE(out[k].odom) << "no odom (tracking " << out[k].info->tracking << ": "
+                             << out[k].info->message << ")";
+    const acvo::OdometryInfo& info = *out[k].info;
+    const nav_msgs::Odometry& odom = *out[k].odom;
+    EXPECT_EQ(info.tracking, k == 0 ? "first_frame" : "ok") << info.message;
+    EXPECT_FALSE(info.lost);
+    EXPECT_EQ(odom.header.frame_id, client->odom_frame_);
+    EXPECT_EQ(odom.child_frame_id, client->base_frame_);
+    EXPECT_EQ(info.header.frame_id, acvo_ros::stripSlash(client->camera_frame_));
+    EXPECT_GT(info.moving_points, 100u);
+    EXPECT_GT(info.ms_total, 0.0);
+    // Pose covariance: never zero, grows with every frame (random walk), below "lost".
+    for (int d = 0; d < 6; ++d) EXPECT_GT(odom.pose.covariance[7 * d], 0.0);
+    const double variance = odom.pose.covariance[0] + odom.pose.covariance[7] +
+                            odom.pose.covariance[14];
+    if (k > 0) {
+      EXPECT_GT(info.iterations, 0);
+      EXPECT_GT(info.fixed_points, 100u);
+      EXPECT_GT(variance, last_variance);
+      EXPECT_LT(variance, acvo_ros::kLostVariance);
+      for (int d = 0; d < 6; ++d) EXPECT_GT(odom.twist.covariance[7 * d], 0.0);
+      // Twist: the base-frame motion of one frame over 0.1 s.
+      const Eigen::Isometry3d step = client->expectedBase(acvo_test::frameMotion());
+      Eigen::Vector3d v(odom.twist.twist.linear.x, odom.twist.twist.linear.y,
+                        odom.twist.twist.linear.z);
+      EXPECT_LT((v - step.translation() / 0.1).norm(), 0.05) << "m/s";
+    }
+    last_variance = variance;
+  }
+  expectPoseNear(out.back().odom->pose.pose,
+                 client->expectedBase(cameraPose(kTrackFrames - 1)), "final pose");
+
+  const auto tf = client->lookup(stamps.back());
+  ASSERT_TRUE(tf) << client->odom_frame_ << " -> " << client->base_frame_ << " not in TF";
+  const Eigen::Isometry3d tf_pose = tf2::transformToEigen(*tf);
+  EXPECT_TRUE(tf_pose.isApprox(toEigen(out.back().odom->pose.pose), 1e-6));
+
+  const auto diag = client->waitDiagnostic(diagnostic_msgs::DiagnosticStatus::OK);
+  ASSERT_TRUE(diag);
+  EXPECT_EQ(diag->level, diagnostic_msgs::DiagnosticStatus::OK) << diag->message;
+  EXPECT_EQ(diag->message, "tracking");
+}
+
+TEST(OdometryNodelet, CloudIsPublishedToASubscriberInTheCameraFrame) {
+  ASSERT_TRUE(client->reset());
+  std::mutex m;
+  std::vector<sensor_msgs::PointCloud2> clouds;
+  ros::Subscriber sub = client->nh_.subscribe<sensor_msgs::PointCloud2>(
+      "cloud", 10, [&](const sensor_msgs::PointCloud2ConstPtr& c) {
+        std::lock_guard<std::mutex> lock(m);
+        clouds.push_back(*c);
+      });
+  for (int i = 0; i < 200 && sub.getNumPublishers() == 0; ++i) ros::WallDuration(0.05).sleep();
+  ASSERT_GT(sub.getNumPublishers(), 0u);
+  ros::WallDuration(0.3).sleep();  // the publisher's side of the connection
+  std::vector<ros::Time> stamps;
+  const std::vector<Outcome> out = client->run({0, 1, 2}, &stamps);
+  ros::WallDuration(0.5).sleep();
+  std::lock_guard<std::mutex> lock(m);
+  ASSERT_EQ(clouds.size(), 3u);
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(clouds[i].header.stamp, stamps[i]);
+    EXPECT_EQ(clouds[i].header.frame_id, acvo_ros::stripSlash(client->camera_frame_));
+    ASSERT_TRUE(out[i].info);
+    EXPECT_EQ(clouds[i].width, out[i].info->moving_points);
+    ASSERT_EQ(clouds[i].fields.size(), 4u);
+    EXPECT_EQ(clouds[i].fields[3].name, "rgb");
+  }
+  // Points lie in the camera frame: in front of it, within the room's depth.
+  float xyz[3];
+  std::memcpy(xyz, clouds[0].data.data(), sizeof xyz);
+  EXPECT_GT(xyz[2], 0.5f);
+  EXPECT_LT(xyz[2], 6.0f);
+}
+
+TEST(OdometryNodelet, ResetReturnsToIdentityAndToAGivenPose) {
+  ASSERT_TRUE(client->reset());
+  client->run(range(0, 4));
+  ASSERT_TRUE(client->reset());
+  std::vector<Outcome> out = client->run(range(4, 8));
+  ASSERT_TRUE(out[0].odom && out.back().odom);
+  EXPECT_EQ(out[0].info->tracking, "first_frame");
+  expectPoseNear(out[0].odom->pose.pose, Eigen::Isometry3d::Identity(), "after reset_odom");
+  expectPoseNear(out.back().odom->pose.pose,
+                 client->expectedBase(cameraPose(4).inverse() * cameraPose(7)),
+                 "3 frames after reset_odom");
+
+  Eigen::Isometry3d given = Eigen::Isometry3d::Identity();
+  given.linear() = Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ()).matrix();
+  given.translation() << 1.0, -2.0, 0.5;
+  const auto res = client->resetTo(given);
+  ASSERT_TRUE(res);
+  EXPECT_TRUE(res->success) << res->message;
+  out = client->run(range(8, 12));
+  ASSERT_TRUE(out[0].odom && out.back().odom);
+  expectPoseNear(out[0].odom->pose.pose, given, "after reset_odom_to_pose");
+  expectPoseNear(out.back().odom->pose.pose,
+                 given * client->expectedBase(cameraPose(8).inverse() * cameraPose(11)),
+                 "3 frames after reset_odom_to_pose");
+
+  geometry_msgs::Pose bad;  // zero quaternion
+  acvo::ResetToPose srv;
+  srv.request.pose = bad;
+  ASSERT_TRUE(client->reset_to_pose_.call(srv));
+  EXPECT_FALSE(srv.response.success);
+}
+
+TEST(OdometryNodelet, InvalidFramesAreLostThenTrackingResumes) {
+  ASSERT_TRUE(client->reset());
+  std::vector<Outcome> good = client->run(range(0, 4));
+  ASSERT_TRUE(good.back().odom);
+  const geometry_msgs::Pose held = good.back().odom->pose.pose;
+  const std::uint32_t lost_before = good.back().info->lost_count;
+
+  // Depth all invalid, then a featureless grey image with valid depth.
+  const ros::Time t_blank = client->nextStamp();
+  client->send(client->blank(), t_blank);
+  RgbdImage grey{cv::Mat(client->frame(4).rgb.size(), CV_8UC3, cv::Scalar(128, 128, 128)),
+                 client->frame(4).depth};
+  const ros::Time t_grey = client->nextStamp();
+  client->send(grey, t_grey);
+  Outcome blank = client->outcome(t_blank, true);
+  client->flush();
+  Outcome flat = client->outcome(t_grey, true);
+  for (const Outcome* o : {&blank, &flat}) {
+    ASSERT_TRUE(o->info);
+    EXPECT_TRUE(o->info->lost) << o->info->tracking << ": " << o->info->message;
+    EXPECT_EQ(o->info->tracking, "lost");
+    EXPECT_FALSE(o->info->message.empty());
+    ASSERT_TRUE(o->odom) << "publish_null_when_lost is false: the held pose is published";
+    EXPECT_GE(o->odom->pose.covariance[0], acvo_ros::kLostVariance);
+    EXPECT_GE(o->odom->twist.covariance[35], acvo_ros::kLostVariance);
+    expectPoseNear(o->odom->pose.pose, toEigen(held), "held pose while lost");
+  }
+  EXPECT_EQ(flat.info->lost_count, lost_before + 2);
+  const auto diag = client->waitDiagnostic(diagnostic_msgs::DiagnosticStatus::ERROR);
+  ASSERT_TRUE(diag);
+  EXPECT_EQ(diag->level, diagnostic_msgs::DiagnosticStatus::ERROR);
+  EXPECT_EQ(diag->message, "lost");
+
+  // The node still answers and tracks again from good frames (the reference re-seeds from the
+  // first good frame, so the motion from there on is measured again).
+  std::vector<Outcome> again = client->run(range(5, 9));
+  ASSERT_TRUE(again.back().info);
+  EXPECT_FALSE(again.back().info->lost) << again.back().info->message;
+  EXPECT_EQ(again.back().info->tracking, "ok");
+  ASSERT_TRUE(again[0].odom && again.back().odom);
+  const Eigen::Isometry3d since =
+      toEigen(again[0].odom->pose.pose).inverse() * toEigen(again.back().odom->pose.pose);
+  const Eigen::Isometry3d want = client->expectedBase(cameraPose(5).inverse() * cameraPose(8));
+  EXPECT_LT((since.translation() - want.translation()).norm(), kTranslationTolerance);
+  const auto ok = client->waitDiagnostic(diagnostic_msgs::DiagnosticStatus::OK);
+  ASSERT_TRUE(ok);
+  EXPECT_EQ(ok->message, "tracking");
+}
+
+TEST(OdometryNodelet, BadInputIsNamedAndSkippedAndTheNodeCarriesOn) {
+  ASSERT_TRUE(client->reset());
+  client->run(range(0, 3));
+  struct Bad {
+    std::string what;
+    std::function<void(sensor_msgs::Image&, sensor_msgs::Image&, sensor_msgs::CameraInfo&)> spoil;
+    std::string expected;  // in odom_info.message
+  };
+  const std::vector<Bad> cases = {
+      {"depth encoding", [](auto&, auto& d, auto&) { d.encoding = "8UC1"; d.step = d.width; d.data.resize(d.step * d.height); }, "'8UC1'"},
+      {"colour encoding", [](auto& c, auto&, auto&) { c.encoding = "bayer_rggb8"; }, "'bayer_rggb8'"},
+      {"truncated colour", [](auto& c, auto&, auto&) { c.data.resize(c.data.size() / 2); }, "truncated"},
+      {"short step", [](auto&, auto& d, auto&) { d.step = d.width; }, "step"},
+      {"size mismatch", [](auto&, auto& d, auto&) { d.width /= 2; d.step /= 2; }, "differ in size"},
+      {"zero focal length", [](auto&, auto&, auto& i) { i.K[0] = 0.0; }, "focal"},
+      {"camera_info size", [](auto&, auto&, auto& i) { i.width = 640; }, "camera_info size"},
+  };
+  for (const Bad& bad : cases) {
+    SCOPED_TRACE(bad.what);
+    const ros::Time t = client->nextStamp();
+    client->send(client->frame(3), t, bad.spoil);
+    client->flush();
+    const Outcome o = client->outcome(t, false);
+    ASSERT_TRUE(o.info) << "no odom_info for a bad frame: node dead?";
+    EXPECT_EQ(o.info->tracking, "bad_frame");
+    EXPECT_NE(o.info->message.find(bad.expected), std::string::npos) << o.info->message;
+    EXPECT_FALSE(o.odom) << "a bad frame must not be published";
+  }
+  // The topic is named for encoding problems.
+  const ros::Time t = client->nextStamp();
+  client->send(client->frame(3), t, [](auto&, auto& d, auto&) { d.encoding = "mono16x"; });
+  client->flush();
+  const Outcome named = client->outcome(t, false);
+  ASSERT_TRUE(named.info);
+  EXPECT_NE(named.info->message.find("cam/depth"), std::string::npos) << named.info->message;
+
+  // Good frames go on from the last good one as if nothing happened.
+  const std::vector<Outcome> out = client->run(range(3, 6));
+  ASSERT_TRUE(out.back().odom);
+  EXPECT_EQ(out.back().info->tracking, "ok") << out.back().info->message;
+  expectPoseNear(out.back().odom->pose.pose, client->expectedBase(cameraPose(5)),
+                 "after bad frames");
+}
+
+TEST(OdometryNodelet, StampsRepeatedAreDroppedAndAJumpBackRestarts) {
+  if (!client->exact_stamps_) {
+    GTEST_SKIP() << "approximate sync drops reordered stamps itself; run with exact sync";
+  }
+  ASSERT_TRUE(client->reset());
+  std::vector<ros::Time> stamps;
+  client->run(range(0, 3), &stamps);
+  // The same stamp again: dropped before it reaches the odometry (no second odom_info).
+  ASSERT_EQ(client->infoCount(stamps.back()), 1);
+  client->send(client->frame(3), stamps.back());
+  // A later frame shows the node still processes frames, and gives the repeat time to arrive.
+  const ros::Time later = client->nextStamp();
+  client->send(client->frame(3), later);
+  ASSERT_TRUE(client->outcome(later, true).odom);
+  EXPECT_EQ(client->infoCount(stamps.back()), 1) << "a repeated stamp was processed";
+  // A stamp 5 s in the past: a restarted bag; odometry starts again at identity.
+  const ros::Time back = later - ros::Duration(5.0);
+  client->send(client->frame(4), back);
+  const Outcome restarted = client->outcome(back, true);
+  ASSERT_TRUE(restarted.info);
+  EXPECT_EQ(restarted.info->tracking, "first_frame");
+  ASSERT_TRUE(restarted.odom);
+  expectPoseNear(restarted.odom->pose.pose, Eigen::Isometry3d::Identity(), "after jump back");
+}
+
+TEST(OdometryNodelet, NoDataIsAnError) {
+  ros::WallDuration(1.5).sleep();  // no_data_timeout is 1 s in the .test files
+  const auto diag = client->waitDiagnostic(diagnostic_msgs::DiagnosticStatus::ERROR);
+  ASSERT_TRUE(diag);
+  EXPECT_EQ(diag->message, "no data");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_odometry_nodelet");
+  ros::AsyncSpinner spinner(2);
+  spinner.start();
+  Client c;
+  client = &c;
+  if (!c.connect()) {
+    std::cerr << "the nodelet did not come up (topics or reset_odom missing)\n";
+    return 1;
+  }
+  const int result = RUN_ALL_TESTS();
+  client = nullptr;
+  return result;
+}
