@@ -2,6 +2,7 @@
 // motion (constant velocity or identity), registers, composes the pose, judges tracking.
 #pragma once
 
+#include <memory>
 #include <optional>
 
 #include <Eigen/Geometry>
@@ -24,8 +25,10 @@ struct OdometryResult {
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   // Motion from this frame's camera to the previous frame's camera (T: current -> previous).
   Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
-  // Covariance of the relative motion (left perturbation, order: rotation x y z, translation
-  // x y z; rad^2 and m^2), in this frame's camera frame.
+  // Covariance of the relative motion `motion` for a left perturbation motion -> exp(xi^) motion,
+  // xi = (rotation x y z, translation x y z), expressed in the previous camera's frame; rad^2 and
+  // m^2. Model: covariance_scale * (-H)^-1 with H the curvature of the objective at the optimum
+  // (SolverResult::hessian); multiplied by 10 when tracking is hard; 1e6 on the diagonal when lost.
   Eigen::Matrix<double, 6, 6> motion_covariance = Eigen::Matrix<double, 6, 6>::Identity();
   SolverResult solver;
   std::size_t fixed_points = 0;
@@ -35,9 +38,20 @@ struct OdometryResult {
   CloudStats cloud_stats;
 };
 
+// Tracking judgement of a registered frame:
+//  - lost: the solver failed (too few points, not finite), the normalised inner product is below
+//    lost_inner_product, or the motion exceeds max_translation / max_rotation per frame. The pose
+//    is kept, the motion prior is dropped and the reference is re-seeded from this frame (kept
+//    when this frame has too few points, so a blank frame does not erase a good reference).
+//  - hard: inner product below hard_inner_product, iteration cap reached, or the length-scale
+//    pinned at a bound at the end.
+//  - ok otherwise.
 class Odometry {
  public:
   explicit Odometry(const Params& params = Params());
+  ~Odometry();
+  Odometry(Odometry&&) noexcept;
+  Odometry& operator=(Odometry&&) noexcept;
 
   // Processes one frame. A frame with a problem (Frame::problem()) is rejected with
   // Tracking::kBadFrame and does not change the state.
@@ -56,7 +70,8 @@ class Odometry {
   Eigen::Isometry3d pose_ = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();  // last relative motion
   std::optional<PreparedCloud> reference_;
-  int lost_streak_ = 0;
+  struct Arena;  // the thread pool the solver runs in (odometry.threads)
+  std::unique_ptr<Arena> arena_;
 };
 
 }  // namespace acvo

@@ -43,6 +43,15 @@ struct SolverParams {
 struct OdometryParams {
   InitialGuess initial_guess = InitialGuess::kConstantVelocity;
   int threads = 0;  // 0 = all cores
+  // Tracking judgement (see odometry.hpp): lost below this normalised inner product, or when a
+  // frame-to-frame motion exceeds the limits below; hard to track below hard_inner_product.
+  double lost_inner_product = 0.05;
+  double hard_inner_product = 0.15;
+  double max_translation = 0.3;   // m per frame
+  double max_rotation = 20.0;     // deg per frame
+  // Relative-motion covariance = covariance_scale * (-H)^-1, H the curvature of the objective at
+  // the optimum; see odometry.hpp.
+  double covariance_scale = 1.0;
 };
 
 struct Params {
@@ -88,6 +97,11 @@ void visitParams(Params_& p, Visitor&& visit) {
   visit("solver", "min_points", p.solver.min_points);
   visit("odometry", "initial_guess", p.odometry.initial_guess);
   visit("odometry", "threads", p.odometry.threads);
+  visit("odometry", "lost_inner_product", p.odometry.lost_inner_product);
+  visit("odometry", "hard_inner_product", p.odometry.hard_inner_product);
+  visit("odometry", "max_translation", p.odometry.max_translation);
+  visit("odometry", "max_rotation", p.odometry.max_rotation);
+  visit("odometry", "covariance_scale", p.odometry.covariance_scale);
 }
 
 // Empty when the values are consistent; otherwise a message naming the offending parameter.

@@ -2,7 +2,9 @@
 // labelled clouds over SE(3), with a fixed length-scale schedule or the adaptive one.
 #pragma once
 
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -14,6 +16,15 @@ namespace acvo {
 
 enum class SolverStatus { kConverged, kMaxIterations, kTooFewPoints, kNotFinite };
 std::string toString(SolverStatus s);
+
+// What one iteration did (kept for tests, benchmarks and diagnosis; a few doubles each).
+struct IterationTrace {
+  double ell = 0.0;      // length-scale used by the iteration
+  double ell_max = 0.0;  // ell_max after the iteration's update
+  double step = 0.0;     // step size t
+  double objective = 0.0;  // F before the update
+  std::int64_t nnz = 0;
+};
 
 struct SolverResult {
   // Maps points of the moving (current) cloud into the fixed (previous) cloud's frame.
@@ -29,6 +40,7 @@ struct SolverResult {
   // (omega, v) of the transform, 6x6, negative semi-definite at a maximum.
   Eigen::Matrix<double, 6, 6> hessian = Eigen::Matrix<double, 6, 6>::Zero();
   double objective = 0.0;      // F at the optimum
+  std::vector<IterationTrace> trace;
   // Time per stage, milliseconds.
   double ms_total = 0.0;
   double ms_neighbours = 0.0;  // cross-pair search + kernel + gradient pass

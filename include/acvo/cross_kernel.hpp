@@ -1,0 +1,79 @@
+// The per-iteration work of the solver: the cross kernel A = K(X, T Z) with its sparsified pairs,
+// the ascent direction (omega, v), the 4th-order step-size sums B..E, the length-scale terms and
+// the curvature at the optimum; plus the self-kernel sums of one cloud. Split from the solver's
+// control flow so that each formula can be tested on its own (method.md §2-§4).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "acvo/kernel.hpp"
+#include "acvo/params.hpp"
+
+namespace acvo {
+
+struct CrossSums {
+  Eigen::Vector3d omega = Eigen::Vector3d::Zero();  // (1/c) sum a (x cross y)
+  Eigen::Vector3d v = Eigen::Vector3d::Zero();      // (1/d) sum a (y - x)
+  double F = 0.0;         // sum a_ij (the objective, also <f_X, h.f_Z>)
+  double F_d2 = 0.0;      // sum a_ij |x_i - y_j|^2 (length-scale gradient term)
+  std::int64_t nnz = 0;   // kept pairs
+};
+
+struct StepSums {
+  double B = 0.0, C = 0.0, D = 0.0, E = 0.0;
+};
+
+// Self-kernel sums of one cloud at a length-scale: sum a, sum a d^2, number of kept entries,
+// over ordered pairs including i = j. Rows below `first_row` are left out (the authors' code
+// drops them for Ayy; 0 keeps everything).
+struct SelfSums {
+  double sum = 0.0;
+  double sum_d2 = 0.0;
+  std::int64_t nnz = 0;
+};
+SelfSums selfKernelSums(const PreparedCloud& cloud, double ell, const SolverParams& params,
+                        int first_row = 0);
+
+class CrossKernel {
+ public:
+  CrossKernel(const PreparedCloud& fixed, const PreparedCloud& moving, const SolverParams& params);
+
+  // Finds the kept pairs at transform T and length-scale ell and accumulates their sums.
+  // The pairs are kept for stepSums() and curvature() until the next call.
+  const CrossSums& evaluate(const Eigen::Isometry3d& T, double ell);
+
+  // B..E of the 4th-order expansion of F along y(t) = exp(-t xi^) y, xi = (omega, v), over the
+  // pairs of the last evaluate().
+  StepSums stepSums(const Eigen::Vector3d& omega, const Eigen::Vector3d& v) const;
+
+  // d^2 F / d xi^2 for a left perturbation y -> exp(xi^) y, xi = (omega, v), at the last
+  // evaluate() (Gauss-Newton form: the second derivative of exp itself is left out).
+  Eigen::Matrix<double, 6, 6> curvature() const;
+
+  const CrossSums& sums() const { return sums_; }
+
+ private:
+  struct Pair {
+    int i;
+    float a;
+  };
+  struct Chunk {
+    std::vector<Pair> pairs;
+    std::vector<int> pair_end;  // per moving point of the chunk: end index into pairs
+    CrossSums sums;
+  };
+
+  const PreparedCloud& fixed_;
+  const PreparedCloud& moving_;
+  SolverParams params_;
+  double ell_ = 0.0;
+  std::vector<Eigen::Vector3f> y_;  // transformed moving points
+  std::vector<Chunk> chunks_;
+  CrossSums sums_;
+};
+
+}  // namespace acvo

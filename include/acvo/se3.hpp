@@ -1,0 +1,26 @@
+// SE(3) exponential and logarithm in closed form, double precision, with small-angle series.
+// Twists are ordered (omega, v): rotation first, then translation.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace acvo {
+
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+
+Eigen::Matrix3d hat(const Eigen::Vector3d& w);
+
+// Rodrigues: exp([w]x).
+Eigen::Matrix3d expSO3(const Eigen::Vector3d& w);
+// Rotation vector of R (angle in [0, pi]); robust near 0 and near pi.
+Eigen::Vector3d logSO3(const Eigen::Matrix3d& R);
+
+// exp of the twist xi = (omega, v): R = exp([omega]x), t = V(omega) v. omega = 0 gives exactly t = v.
+Eigen::Isometry3d expSE3(const Vector6d& xi);
+Vector6d logSE3(const Eigen::Isometry3d& T);
+
+// Re-orthonormalises the rotation part (guards long chains of products against drift).
+Eigen::Isometry3d normalized(const Eigen::Isometry3d& T);
+
+}  // namespace acvo

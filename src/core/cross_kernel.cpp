@@ -1,0 +1,215 @@
+#include "acvo/cross_kernel.hpp"
+
+#include "acvo/se3.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+namespace acvo {
+namespace {
+
+// Moving points per chunk. Chunks are the unit of parallel work and of the reduction, which
+// runs over them in a fixed order: results do not depend on the number of threads.
+constexpr int kChunk = 64;
+
+template <typename F>
+void forEachChunk(int chunks, F&& f) {
+  tbb::parallel_for(tbb::blocked_range<int>(0, chunks, 1),
+                    [&](const tbb::blocked_range<int>& r) {
+                      for (int c = r.begin(); c != r.end(); ++c) f(c);
+                    },
+                    tbb::simple_partitioner());
+}
+
+}  // namespace
+
+SelfSums selfKernelSums(const PreparedCloud& cloud, double ell, const SolverParams& p,
+                        int first_row) {
+  SelfSums s;
+  const double sigma2 = p.sigma * p.sigma;
+  const double sp = p.sparsification;
+  const double inv = 1.0 / (2.0 * ell * ell);
+  const int n = int(cloud.size());
+  // Diagonal: distance 0, colour factor sigma_c^2.
+  const double diag = sigma2 * p.color_sigma * p.color_sigma;
+  if (diag >= sp) {
+    const int rows = std::max(0, n - std::max(first_row, 0));
+    s.sum += rows * diag;
+    s.nnz += rows;
+  }
+  for (const auto& q : cloud.self_pairs) {
+    const double a = sigma2 * std::exp(-q.d2 * inv) * q.color;
+    if (a < sp) continue;
+    // The pair stands for the two ordered entries (i, j) and (j, i).
+    const int entries = int(q.i >= first_row) + int(q.j >= first_row);
+    s.sum += entries * a;
+    s.sum_d2 += entries * a * q.d2;
+    s.nnz += entries;
+  }
+  return s;
+}
+
+CrossKernel::CrossKernel(const PreparedCloud& fixed, const PreparedCloud& moving,
+                         const SolverParams& params)
+    : fixed_(fixed), moving_(moving), params_(params) {
+  y_.resize(moving_.size());
+  chunks_.resize((moving_.size() + kChunk - 1) / kChunk);
+}
+
+const CrossSums& CrossKernel::evaluate(const Eigen::Isometry3d& T, double ell) {
+  ell_ = ell;
+  const Eigen::Matrix3f R = T.linear().cast<float>();
+  const Eigen::Vector3f t = T.translation().cast<float>();
+  const float r2 = float(spatialRadius2(ell, params_.sigma, params_.sparsification));
+  const float inv = float(1.0 / (2.0 * ell * ell));
+  const float sigma2 = float(params_.sigma * params_.sigma);
+  const float color_sigma2 = float(params_.color_sigma * params_.color_sigma);
+  const float color_inv = float(1.0 / (2.0 * params_.color_ell * params_.color_ell));
+  const float sp = float(params_.sparsification);
+  const auto& X = fixed_.cloud.points;
+  const auto& fx = fixed_.cloud.labels;
+  const auto& Z = moving_.cloud.points;
+  const auto& gz = moving_.cloud.labels;
+  const int n = int(Z.size());
+
+  forEachChunk(int(chunks_.size()), [&](int c) {
+    Chunk& chunk = chunks_[c];
+    chunk.pairs.clear();
+    chunk.pair_end.clear();
+    // Per-chunk accumulation in double; the chunk's points are few, float terms are exact enough.
+    Eigen::Vector3d omega = Eigen::Vector3d::Zero(), v = Eigen::Vector3d::Zero();
+    double F = 0.0, F_d2 = 0.0;
+    const int end = std::min(n, (c + 1) * kChunk);
+    for (int j = c * kChunk; j < end; ++j) {
+      const Eigen::Vector3f y = R * Z[j] + t;
+      y_[j] = y;
+      Eigen::Vector3f cross_sum = Eigen::Vector3f::Zero(), diff_sum = Eigen::Vector3f::Zero();
+      float a_sum = 0.0f, ad2_sum = 0.0f;
+      fixed_.grid.forEachCandidate(y, [&](int i) {
+        const Eigen::Vector3f d = y - X[i];
+        const float d2 = d.squaredNorm();
+        if (!(d2 < r2)) return;
+        const float ks = sigma2 * std::exp(-d2 * inv);
+        if (ks * color_sigma2 < sp) return;
+        const float a = ks * colorFactor(fx[i], gz[j], color_inv, color_sigma2);
+        if (a < sp) return;
+        chunk.pairs.push_back({i, a});
+        cross_sum += a * X[i].cross(y);
+        diff_sum += a * d;
+        a_sum += a;
+        ad2_sum += a * d2;
+      });
+      chunk.pair_end.push_back(int(chunk.pairs.size()));
+      omega += cross_sum.cast<double>();
+      v += diff_sum.cast<double>();
+      F += a_sum;
+      F_d2 += ad2_sum;
+    }
+    chunk.sums.omega = omega;
+    chunk.sums.v = v;
+    chunk.sums.F = F;
+    chunk.sums.F_d2 = F_d2;
+    chunk.sums.nnz = std::int64_t(chunk.pairs.size());
+  });
+
+  sums_ = CrossSums();
+  for (const auto& chunk : chunks_) {
+    sums_.omega += chunk.sums.omega;
+    sums_.v += chunk.sums.v;
+    sums_.F += chunk.sums.F;
+    sums_.F_d2 += chunk.sums.F_d2;
+    sums_.nnz += chunk.sums.nnz;
+  }
+  sums_.omega /= params_.omega_scale;
+  sums_.v /= params_.v_scale;
+  return sums_;
+}
+
+StepSums CrossKernel::stepSums(const Eigen::Vector3d& omega_d, const Eigen::Vector3d& v_d) const {
+  const Eigen::Vector3f omega = omega_d.cast<float>(), v = v_d.cast<float>();
+  const double inv_l2 = 1.0 / (ell_ * ell_);
+  const auto& X = fixed_.cloud.points;
+  const int n = int(y_.size());
+  std::vector<StepSums> partial(chunks_.size());
+
+  forEachChunk(int(chunks_.size()), [&](int c) {
+    const Chunk& chunk = chunks_[c];
+    double B = 0, C = 0, D = 0, E = 0;
+    int k = 0;
+    const int end = std::min(n, (c + 1) * kChunk);
+    for (int j = c * kChunk; j < end; ++j) {
+      const int k_end = chunk.pair_end[j - c * kChunk];
+      if (k == k_end) continue;
+      // The powers of the twist applied to y depend only on y: once per moving point.
+      const Eigen::Vector3f y = y_[j];
+      const Eigen::Vector3f x1 = omega.cross(y) + v;  // xi z
+      const Eigen::Vector3f x2 = omega.cross(x1);     // xi^2 z = W^2 y + W v
+      const Eigen::Vector3f x3 = omega.cross(x2);
+      const Eigen::Vector3f x4 = omega.cross(x3);
+      // Exponent of a_ij(t) = a_ij exp(beta t + gamma t^2 + delta t^3 + eps t^4 + O(t^5)), from
+      // x - y(t) = d + t x1 - t^2/2 x2 + t^3/6 x3 - t^4/24 x4 with d = x - y. (method.md writes
+      // these terms without exp's factorials; with them, C, D and E are the Taylor coefficients
+      // of F, which the tests check against finite differences.)
+      const double g_const = x1.squaredNorm();
+      const double d_const = 0.5 * x1.dot(x2);
+      const double e_const = 0.25 * x2.squaredNorm() + x1.dot(x3) / 3.0;
+      for (; k < k_end; ++k) {
+        const auto& pr = chunk.pairs[k];
+        const Eigen::Vector3f d = X[pr.i] - y;
+        const double beta = -inv_l2 * x1.dot(d);
+        const double gamma = -0.5 * inv_l2 * (g_const - x2.dot(d));
+        const double delta = inv_l2 * (d_const - x3.dot(d) / 6.0);
+        const double eps = -0.5 * inv_l2 * (e_const - x4.dot(d) / 12.0);
+        const double a = pr.a, b2 = beta * beta;
+        B += a * beta;
+        C += a * (gamma + 0.5 * b2);
+        D += a * (delta + beta * gamma + b2 * beta / 6.0);
+        E += a * (eps + beta * delta + 0.5 * b2 * gamma + 0.5 * gamma * gamma + b2 * b2 / 24.0);
+      }
+    }
+    partial[c] = {B, C, D, E};
+  });
+
+  StepSums s;
+  for (const auto& p : partial) {
+    s.B += p.B;
+    s.C += p.C;
+    s.D += p.D;
+    s.E += p.E;
+  }
+  return s;
+}
+
+Eigen::Matrix<double, 6, 6> CrossKernel::curvature() const {
+  // a(y) = k exp(-|x - y|^2 / 2l^2): d2a/dy2 = a (d d^T / l^4 - I / l^2), d = x - y, and
+  // dy/dxi = [-[y]x, I] for y -> exp(xi^) y.
+  const double inv_l2 = 1.0 / (ell_ * ell_);
+  const auto& X = fixed_.cloud.points;
+  Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
+  const int n = int(y_.size());
+  for (std::size_t c = 0; c < chunks_.size(); ++c) {
+    const Chunk& chunk = chunks_[c];
+    int k = 0;
+    const int end = std::min(n, int(c + 1) * kChunk);
+    for (int j = int(c) * kChunk; j < end; ++j) {
+      const int k_end = chunk.pair_end[j - int(c) * kChunk];
+      if (k == k_end) continue;
+      const Eigen::Vector3d y = y_[j].cast<double>();
+      Eigen::Matrix<double, 3, 6> J;
+      J << -hat(y), Eigen::Matrix3d::Identity();
+      Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
+      for (; k < k_end; ++k) {
+        const auto& pr = chunk.pairs[k];
+        const Eigen::Vector3d d = X[pr.i].cast<double>() - y;
+        M += pr.a * (d * d.transpose() * inv_l2 * inv_l2 - inv_l2 * Eigen::Matrix3d::Identity());
+      }
+      H += J.transpose() * M * J;
+    }
+  }
+  return H;
+}
+
+}  // namespace acvo

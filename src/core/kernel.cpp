@@ -1,0 +1,115 @@
+#include "acvo/kernel.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+namespace acvo {
+
+double sparsificationThreshold(int order, double tolerance) {
+  // With u = 1/(2 s^2), g = exp(-u) and the expansion truncated at order n in 1/s keeps the
+  // terms (-u)^k / k! for k <= n/2. The truncation error grows with u from 0, so the answer is
+  // exp(-u*) for the first u* where it reaches the tolerance.
+  const int kmax = order / 2;
+  auto error = [kmax](double u) {
+    double term = 1.0, sum = 1.0;
+    for (int k = 1; k <= kmax; ++k) {
+      term *= -u / k;
+      sum += term;
+    }
+    return std::abs(std::exp(-u) - sum);
+  };
+  double lo = 0.0, hi = 0.0;
+  const double du = 1e-3;
+  while (error(hi) <= tolerance) {
+    lo = hi;
+    hi += du;
+    if (hi > 50.0) return std::exp(-hi);  // tolerance never reached: threshold vanishes
+  }
+  for (int it = 0; it < 100; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (error(mid) <= tolerance ? lo : hi) = mid;
+  }
+  return std::exp(-lo);
+}
+
+double spatialRadius2(double ell, double sigma, double threshold) {
+  const double s2 = sigma * sigma;
+  if (threshold <= 0.0) return std::numeric_limits<double>::infinity();
+  if (threshold >= s2) return 0.0;
+  return -2.0 * ell * ell * std::log(threshold / s2);
+}
+
+double largestEll(const SolverParams& p) {
+  double ell = std::max(p.ell_init, p.ell_max);
+  if (p.ell_policy == EllPolicy::kFixedSchedule) ell = std::max(ell, 0.15);
+  return ell;
+}
+
+VoxelGrid::VoxelGrid(const std::vector<Eigen::Vector3f>& points, float cell) : cell_(cell) {
+  if (points.empty() || !(cell > 0.0f)) return;
+  Eigen::Vector3f lo = points.front(), hi = points.front();
+  for (const auto& p : points) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  // A cloud spread far beyond the radius would make a huge dense grid: coarsen the cells then
+  // (candidates stay a superset of the true neighbours, searches only get slower).
+  constexpr double kMaxCells = 4e6;
+  for (;;) {
+    const Eigen::Vector3f n = ((hi - lo) / cell_).array().floor() + 1.0f;
+    if (double(n.x()) * n.y() * n.z() <= kMaxCells) {
+      nx_ = int(n.x()), ny_ = int(n.y()), nz_ = int(n.z());
+      break;
+    }
+    cell_ *= 1.5f;
+  }
+  origin_ = lo;
+  const int cells = nx_ * ny_ * nz_;
+  std::vector<int> cell_of(points.size());
+  cell_start_.assign(cells + 1, 0);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3f r = (points[i] - origin_) / cell_;
+    const int x = std::min(int(r.x()), nx_ - 1), y = std::min(int(r.y()), ny_ - 1),
+              z = std::min(int(r.z()), nz_ - 1);
+    cell_of[i] = (z * ny_ + y) * nx_ + x;
+    ++cell_start_[cell_of[i] + 1];
+  }
+  for (int c = 0; c < cells; ++c) cell_start_[c + 1] += cell_start_[c];
+  order_.resize(points.size());
+  std::vector<int> fill(cell_start_.begin(), cell_start_.end() - 1);
+  for (std::size_t i = 0; i < points.size(); ++i) order_[fill[cell_of[i]]++] = int(i);
+}
+
+PreparedCloud prepareCloud(LabelledCloud cloud, const SolverParams& p) {
+  const auto t0 = std::chrono::steady_clock::now();
+  PreparedCloud out;
+  out.cloud = std::move(cloud);
+  const double r2 = spatialRadius2(largestEll(p), p.sigma, p.sparsification);
+  const float cell = std::isfinite(r2) && r2 > 0.0 ? float(std::sqrt(r2)) : 0.1f;
+  out.grid = VoxelGrid(out.cloud.points, cell);
+
+  const float sigma2 = float(p.sigma * p.sigma);
+  const float color_sigma2 = float(p.color_sigma * p.color_sigma);
+  const float color_inv = float(1.0 / (2.0 * p.color_ell * p.color_ell));
+  const float sp = float(p.sparsification);
+  const auto& pts = out.cloud.points;
+  const auto& labels = out.cloud.labels;
+  for (int i = 0; i < int(pts.size()); ++i) {
+    out.grid.forEachCandidate(pts[i], [&](int j) {
+      if (j <= i) return;
+      const float d2 = (pts[i] - pts[j]).squaredNorm();
+      if (!(d2 < r2)) return;
+      const float c = colorFactor(labels[i], labels[j], color_inv, color_sigma2);
+      // Necessary condition whatever the length-scale: the pair at distance 0 must pass.
+      if (sigma2 * c < sp) return;
+      out.self_pairs.push_back({i, j, d2, c});
+    });
+  }
+  out.ms_prepare =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return out;
+}
+
+}  // namespace acvo

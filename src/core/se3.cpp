@@ -1,0 +1,95 @@
+#include "acvo/se3.hpp"
+
+#include <cmath>
+
+namespace acvo {
+namespace {
+
+// Coefficients A = sin(t)/t, B = (1 - cos t)/t^2, C = (t - sin t)/t^3 with series below
+// a small angle, where the closed forms lose precision to cancellation.
+struct RodriguesCoefficients {
+  double A, B, C;
+};
+
+RodriguesCoefficients coefficients(double theta) {
+  const double t2 = theta * theta;
+  if (theta < 0.1) {
+    // Series to theta^8: truncation below 1e-16 relative for theta < 0.1.
+    const double t4 = t2 * t2, t6 = t4 * t2, t8 = t4 * t4;
+    return {1.0 - t2 / 6.0 + t4 / 120.0 - t6 / 5040.0 + t8 / 362880.0,
+            0.5 - t2 / 24.0 + t4 / 720.0 - t6 / 40320.0 + t8 / 3628800.0,
+            1.0 / 6.0 - t2 / 120.0 + t4 / 5040.0 - t6 / 362880.0 + t8 / 39916800.0};
+  }
+  const double s = std::sin(theta), c = std::cos(theta);
+  return {s / theta, (1.0 - c) / t2, (theta - s) / (t2 * theta)};
+}
+
+}  // namespace
+
+Eigen::Matrix3d hat(const Eigen::Vector3d& w) {
+  Eigen::Matrix3d W;
+  W << 0.0, -w.z(), w.y(), w.z(), 0.0, -w.x(), -w.y(), w.x(), 0.0;
+  return W;
+}
+
+Eigen::Matrix3d expSO3(const Eigen::Vector3d& w) {
+  const auto k = coefficients(w.norm());
+  const Eigen::Matrix3d W = hat(w);
+  return Eigen::Matrix3d::Identity() + k.A * W + k.B * W * W;
+}
+
+Eigen::Vector3d logSO3(const Eigen::Matrix3d& R) {
+  // Through the unit quaternion: atan2 keeps full precision at both ends of [0, pi].
+  Eigen::Quaterniond q(R);
+  q.normalize();
+  if (q.w() < 0.0) q.coeffs() = -q.coeffs();
+  const double n = q.vec().norm();
+  const double w = q.w();
+  double scale;
+  if (n < 1e-8) {
+    // theta = 2 atan(n / w) ~ 2 n / w (1 - n^2 / (3 w^2))
+    scale = 2.0 / w * (1.0 - n * n / (3.0 * w * w));
+  } else {
+    scale = 2.0 * std::atan2(n, w) / n;
+  }
+  return scale * q.vec();
+}
+
+Eigen::Isometry3d expSE3(const Vector6d& xi) {
+  const Eigen::Vector3d w = xi.head<3>(), v = xi.tail<3>();
+  const auto k = coefficients(w.norm());
+  const Eigen::Matrix3d W = hat(w), W2 = W * W;
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::Matrix3d::Identity() + k.A * W + k.B * W2;
+  // V = I + B W + C W^2; for omega = 0 this is the identity and t = v exactly.
+  T.translation() = v + k.B * (W * v) + k.C * (W2 * v);
+  return T;
+}
+
+Vector6d logSE3(const Eigen::Isometry3d& T) {
+  const Eigen::Vector3d w = logSO3(T.linear());
+  const double theta = w.norm();
+  const Eigen::Matrix3d W = hat(w);
+  // V^-1 = I - W/2 + D W^2 with D = (1 - A / (2B)) / theta^2.
+  double D;
+  if (theta < 0.1) {
+    const double t2 = theta * theta;
+    D = 1.0 / 12.0 + t2 / 720.0 + t2 * t2 / 30240.0 + t2 * t2 * t2 / 1209600.0;
+  } else {
+    const auto k = coefficients(theta);
+    D = (1.0 - k.A / (2.0 * k.B)) / (theta * theta);
+  }
+  const Eigen::Vector3d v =
+      T.translation() - 0.5 * (W * T.translation()) + D * (W * (W * T.translation()));
+  Vector6d xi;
+  xi << w, v;
+  return xi;
+}
+
+Eigen::Isometry3d normalized(const Eigen::Isometry3d& T) {
+  Eigen::Isometry3d out = T;
+  out.linear() = Eigen::Quaterniond(T.linear()).normalized().toRotationMatrix();
+  return out;
+}
+
+}  // namespace acvo

@@ -1,0 +1,213 @@
+#include "acvo/solver.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <complex>
+
+#include "acvo/cross_kernel.hpp"
+#include "acvo/se3.hpp"
+
+namespace acvo {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+// Smallest positive root of a t + b = 0 / a t^2 + b t + c = 0 (none: +inf).
+double smallestPositiveLinear(double a, double b) {
+  if (a == 0.0) return INFINITY;
+  const double t = -b / a;
+  return t > 0.0 ? t : INFINITY;
+}
+
+double smallestPositiveQuadratic(double a, double b, double c) {
+  const double scale = std::max({std::abs(a), std::abs(b), std::abs(c)});
+  if (scale == 0.0) return INFINITY;
+  if (std::abs(a) <= 1e-14 * scale) return smallestPositiveLinear(b, c);
+  const double disc = b * b - 4.0 * a * c;
+  if (disc < 0.0) return INFINITY;
+  // Numerically stable pair of roots.
+  const double q = -0.5 * (b + std::copysign(std::sqrt(disc), b));
+  double best = INFINITY;
+  for (double t : {q / a, q != 0.0 ? c / q : INFINITY}) {
+    if (t > 0.0 && std::isfinite(t)) best = std::min(best, t);
+  }
+  return best;
+}
+
+// Real roots of t^3 + a t^2 + b t + c (trigonometric / Cardano), polished by Newton steps.
+double smallestPositiveCubic(double A3, double A2, double A1, double A0) {
+  const double scale = std::max({std::abs(A3), std::abs(A2), std::abs(A1), std::abs(A0)});
+  if (scale == 0.0) return INFINITY;
+  if (std::abs(A3) <= 1e-14 * scale) return smallestPositiveQuadratic(A2, A1, A0);
+  const double a = A2 / A3, b = A1 / A3, c = A0 / A3;
+  const double Q = (a * a - 3.0 * b) / 9.0;
+  const double R = (2.0 * a * a * a - 9.0 * a * b + 27.0 * c) / 54.0;
+  double roots[3];
+  int count = 0;
+  if (R * R < Q * Q * Q) {
+    const double theta = std::acos(std::clamp(R / std::sqrt(Q * Q * Q), -1.0, 1.0));
+    const double m = -2.0 * std::sqrt(Q);
+    roots[0] = m * std::cos(theta / 3.0) - a / 3.0;
+    roots[1] = m * std::cos((theta + 2.0 * M_PI) / 3.0) - a / 3.0;
+    roots[2] = m * std::cos((theta - 2.0 * M_PI) / 3.0) - a / 3.0;
+    count = 3;
+  } else {
+    const double Aa = -std::copysign(std::cbrt(std::abs(R) + std::sqrt(R * R - Q * Q * Q)), R);
+    const double Bb = Aa != 0.0 ? Q / Aa : 0.0;
+    roots[0] = Aa + Bb - a / 3.0;
+    count = 1;
+  }
+  double best = INFINITY;
+  for (int k = 0; k < count; ++k) {
+    double t = roots[k];
+    for (int it = 0; it < 3; ++it) {  // polish
+      const double f = ((t + a) * t + b) * t + c;
+      const double df = (3.0 * t + 2.0 * a) * t + b;
+      if (df == 0.0) break;
+      t -= f / df;
+    }
+    if (t > 0.0 && std::isfinite(t)) best = std::min(best, t);
+  }
+  return best;
+}
+
+struct EllState {
+  double ell;
+  double ell_max;
+};
+
+}  // namespace
+
+std::string toString(SolverStatus s) {
+  switch (s) {
+    case SolverStatus::kConverged: return "converged";
+    case SolverStatus::kMaxIterations: return "max_iterations";
+    case SolverStatus::kTooFewPoints: return "too_few_points";
+    case SolverStatus::kNotFinite: return "not_finite";
+  }
+  return "unknown";
+}
+
+double solveStep(double B, double C, double D, double E, double min_step, double max_step) {
+  double t = smallestPositiveCubic(4.0 * E, 3.0 * D, 2.0 * C, B);
+  if (!std::isfinite(t)) t = min_step;
+  return std::min(t, max_step);
+}
+
+double scheduledEll(int iteration) {
+  if (iteration < 2) return 0.15;
+  if (iteration < 9) return 0.10;
+  if (iteration < 19) return 0.06;
+  return 0.03;
+}
+
+SolverResult align(const PreparedCloud& fixed, const PreparedCloud& moving,
+                   const Eigen::Isometry3d& guess, const SolverParams& p) {
+  const auto t_start = Clock::now();
+  SolverResult result;
+  result.transform = guess;
+  result.ell = p.ell_policy == EllPolicy::kAdaptive ? p.ell_init : scheduledEll(0);
+  if (int(fixed.size()) < p.min_points || int(moving.size()) < p.min_points) {
+    result.status = SolverStatus::kTooFewPoints;
+    result.ms_total = msSince(t_start);
+    return result;
+  }
+  if (!guess.matrix().allFinite()) {
+    result.status = SolverStatus::kNotFinite;
+    result.transform = Eigen::Isometry3d::Identity();
+    result.ms_total = msSince(t_start);
+    return result;
+  }
+
+  CrossKernel kernel(fixed, moving, p);
+  Eigen::Isometry3d T = guess;
+  double ell = p.ell_init, ell_max = p.ell_max;
+  const bool adaptive = p.ell_policy == EllPolicy::kAdaptive;
+  const bool reference = p.ell_update == EllUpdate::kReference;
+  result.status = SolverStatus::kMaxIterations;
+  int it = 0;
+  double used_ell = ell;
+  for (; it < p.max_iterations; ++it) {
+    used_ell = adaptive ? ell : scheduledEll(it);
+    auto t0 = Clock::now();
+    const CrossSums& s = kernel.evaluate(T, used_ell);
+    result.ms_neighbours += msSince(t0);
+    if (!s.omega.allFinite() || !s.v.allFinite()) {
+      result.status = SolverStatus::kNotFinite;
+      break;
+    }
+    if (s.omega.norm() < p.eps_gradient && s.v.norm() < p.eps_gradient) {
+      result.status = SolverStatus::kConverged;
+      break;
+    }
+
+    t0 = Clock::now();
+    const StepSums st = kernel.stepSums(s.omega, s.v);
+    const double step = solveStep(st.B, st.C, st.D, st.E, p.min_step, p.max_step);
+    result.ms_step += msSince(t0);
+    Vector6d xi;
+    xi << s.omega, s.v;
+    const Eigen::Isometry3d dT = expSE3(-step * xi);
+    if (!dT.matrix().allFinite()) {
+      result.status = SolverStatus::kNotFinite;
+      break;
+    }
+    T = normalized(dT * T);
+    IterationTrace trace{used_ell, ell_max, step, s.F, s.nnz};
+
+    if (adaptive) {
+      t0 = Clock::now();
+      // dJ/dl with J = |f_X - h.f_Z|^2 (method.md §4), from the pairs of this iteration.
+      const SelfSums xx = selfKernelSums(fixed, ell, p);
+      const SelfSums yy = selfKernelSums(moving, ell, p, reference ? int(fixed.size()) : 0);
+      double grad = (xx.sum_d2 + yy.sum_d2 - 2.0 * s.F_d2) / (ell * ell * ell);
+      const double denom = double(xx.nnz + yy.nnz - 2 * s.nnz);
+      if (denom > 0.0) grad /= denom;
+      if (std::isfinite(grad)) {
+        ell = reference ? ell + p.ell_step * grad : ell - p.ell_step * grad;
+        if (ell >= ell_max) {
+          // ell_max never drops below ell_min: past that the bound would shrink forever.
+          ell_max = std::max(ell_max * p.ell_reduction, p.ell_min);
+          ell = ell_max;
+        }
+        ell = std::max(ell, p.ell_min);
+        const bool pinned = ell <= p.ell_min || ell >= ell_max;
+        result.ell_bound_iterations += pinned ? 1 : 0;
+      }
+      result.ms_ell += msSince(t0);
+    }
+    trace.ell_max = ell_max;
+    result.trace.push_back(trace);
+    if (step * xi.norm() < p.eps_transform) {
+      result.status = SolverStatus::kConverged;
+      ++it;
+      break;
+    }
+  }
+  result.iterations = it;
+  result.transform = T;
+
+  // Final figures at the returned transform.
+  const double final_ell = adaptive ? ell : scheduledEll(it);
+  const CrossSums& s = kernel.evaluate(T, final_ell);
+  result.ell = final_ell;
+  result.ell_at_bound = adaptive && (ell <= p.ell_min || ell >= ell_max);
+  result.nnz = std::size_t(s.nnz);
+  result.objective = s.F;
+  const SelfSums xx = selfKernelSums(fixed, final_ell, p);
+  const SelfSums yy = selfKernelSums(moving, final_ell, p);
+  result.inner_product = xx.sum > 0 && yy.sum > 0 ? s.F / std::sqrt(xx.sum * yy.sum) : 0.0;
+  result.hessian = kernel.curvature();
+  if (!T.matrix().allFinite()) {
+    result.status = SolverStatus::kNotFinite;
+    result.transform = guess.matrix().allFinite() ? guess : Eigen::Isometry3d::Identity();
+  }
+  result.ms_total = msSince(t_start);
+  return result;
+}
+
+}  // namespace acvo

@@ -1,0 +1,236 @@
+// Solver formulas against independent computations (method.md §3, §4).
+#include <gtest/gtest.h>
+
+#include "acvo/cross_kernel.hpp"
+#include "acvo/se3.hpp"
+#include "acvo/solver.hpp"
+#include "cloud_fixtures.hpp"
+
+namespace acvo {
+namespace {
+
+// ---- step size -------------------------------------------------------------------------------
+// 4E t^3 + 3D t^2 + 2C t + B with chosen roots r1, r2, r3: 4E (t-r1)(t-r2)(t-r3).
+double stepFor(double r1, double r2, double r3, double E = 1.0) {
+  const double a3 = 4 * E;
+  const double a2 = -a3 * (r1 + r2 + r3), a1 = a3 * (r1 * r2 + r1 * r3 + r2 * r3),
+               a0 = -a3 * r1 * r2 * r3;
+  return solveStep(a0, a1 / 2, a2 / 3, E, 0.2, 100.0);
+}
+
+TEST(StepSize, SmallestPositiveRealRootOfKnownCubics) {
+  EXPECT_NEAR(stepFor(0.3, 0.7, 2.0), 0.3, 1e-12);
+  EXPECT_NEAR(stepFor(-1.0, 0.45, 5.0), 0.45, 1e-12);
+  EXPECT_NEAR(stepFor(-1.0, -2.0, 0.05, -3.0), 0.05, 1e-12);
+  EXPECT_NEAR(stepFor(1e-3, 1e-3, 7.0), 1e-3, 1e-6);  // double root
+}
+
+TEST(StepSize, DegenerateLeadingTermsAndNoRoot) {
+  // E = 0: quadratic 3D t^2 + 2C t + B with roots 0.25 and 4 -> 0.25.
+  EXPECT_NEAR(solveStep(1.0, -2.125, 1.0 / 3.0, 0.0, 0.2, 10.0), 0.25, 1e-12);
+  // E = D = 0: linear 2C t + B = 0 -> t = 0.6.
+  EXPECT_NEAR(solveStep(1.2, -1.0, 0.0, 0.0, 0.2, 10.0), 0.6, 1e-12);
+  // Only negative / complex roots -> min_step.
+  EXPECT_EQ(stepFor(-0.5, -1.0, -2.0), 0.2);
+  EXPECT_EQ(solveStep(1.0, 1.0, 0.0, 0.0, 0.2, 10.0), 0.2);  // t = -0.5
+  EXPECT_EQ(solveStep(0.0, 0.0, 0.0, 0.0, 0.2, 10.0), 0.2);
+  // Cap honoured.
+  EXPECT_EQ(solveStep(-3.0, 1.0, 0.0, 0.0, 0.2, 0.8), 0.8);  // root 1.5
+}
+
+TEST(FixedSchedule, LengthScalesOfTheOriginalCvo) {
+  EXPECT_EQ(scheduledEll(0), 0.15);
+  EXPECT_EQ(scheduledEll(1), 0.15);
+  EXPECT_EQ(scheduledEll(2), 0.10);
+  EXPECT_EQ(scheduledEll(8), 0.10);
+  EXPECT_EQ(scheduledEll(9), 0.06);
+  EXPECT_EQ(scheduledEll(19), 0.03);
+  EXPECT_EQ(scheduledEll(500), 0.03);
+}
+
+// ---- objective derivatives ---------------------------------------------------------------------
+struct Pair {
+  LabelledCloud X, Z;
+};
+
+Pair offsetPair(unsigned seed, const Vector6d& motion_twist) {
+  Pair p;
+  p.X = test::randomCloud(600, seed, 0.3f);
+  p.Z = test::transformed(p.X, expSE3(motion_twist).inverse());
+  return p;
+}
+
+// A sparsification so small that no pair in these clouds is dropped: F is smooth.
+SolverParams denseParams() {
+  SolverParams p;
+  p.sparsification = 1e-30;
+  return p;
+}
+
+TEST(Gradient, MatchesFiniteDifferenceOfTheObjective) {
+  const SolverParams p = denseParams();
+  const Pair pr = offsetPair(11, (Vector6d() << 0.03, -0.02, 0.01, 0.03, 0.02, -0.01).finished());
+  const PreparedCloud fx = prepareCloud(pr.X, p), mz = prepareCloud(pr.Z, p);
+  CrossKernel kernel(fx, mz, p);
+  const double ell = 0.1;
+  const CrossSums s = kernel.evaluate(Eigen::Isometry3d::Identity(), ell);
+  // dF/dxi for y -> exp(xi^) y equals -(c/l^2) omega and -(d/l^2) v.
+  Vector6d expected;
+  expected << -p.omega_scale / (ell * ell) * s.omega, -p.v_scale / (ell * ell) * s.v;
+  const double h = 1e-6;
+  for (int k = 0; k < 6; ++k) {
+    Vector6d e = Vector6d::Zero();
+    e[k] = h;
+    const double fp = test::bruteForce(pr.X, pr.Z, expSE3(e), ell, p).F;
+    const double fm = test::bruteForce(pr.X, pr.Z, expSE3(-e), ell, p).F;
+    const double fd = (fp - fm) / (2 * h);
+    EXPECT_NEAR(expected[k], fd, 2e-4 * expected.norm()) << "component " << k;
+  }
+}
+
+TEST(StepSums, BIsTheDerivativeAlongTheFlow) {
+  const SolverParams p = denseParams();
+  const Pair pr = offsetPair(12, (Vector6d() << -0.02, 0.03, 0.02, -0.02, 0.03, 0.02).finished());
+  const PreparedCloud fx = prepareCloud(pr.X, p), mz = prepareCloud(pr.Z, p);
+  CrossKernel kernel(fx, mz, p);
+  const double ell = 0.1;
+  const CrossSums s = kernel.evaluate(Eigen::Isometry3d::Identity(), ell);
+  const StepSums st = kernel.stepSums(s.omega, s.v);
+  Vector6d xi;
+  xi << s.omega, s.v;
+  auto F = [&](double t) { return test::bruteForce(pr.X, pr.Z, expSE3(-t * xi), ell, p).F; };
+  const double h = 1e-4;
+  const double d1 = (F(h) - F(-h)) / (2 * h);
+  EXPECT_NEAR(st.B, d1, 1e-5 * std::abs(d1));
+  EXPECT_GT(st.B, 0.0) << "(omega, v) must be an ascent direction";
+}
+
+TEST(StepSums, CDEAreTheTaylorCoefficientsOfTheObjective) {
+  const SolverParams p = denseParams();
+  const Pair pr = offsetPair(14, (Vector6d() << 0.02, -0.03, 0.01, 0.03, 0.01, -0.02).finished());
+  const PreparedCloud fx = prepareCloud(pr.X, p), mz = prepareCloud(pr.Z, p);
+  CrossKernel kernel(fx, mz, p);
+  const double ell = 0.1;
+  const CrossSums s = kernel.evaluate(Eigen::Isometry3d::Identity(), ell);
+  const StepSums st = kernel.stepSums(s.omega, s.v);
+  Vector6d xi;
+  xi << s.omega, s.v;
+  auto F = [&](double t) { return test::bruteForce(pr.X, pr.Z, expSE3(-t * xi), ell, p).F; };
+  // Central differences on a scale where the quartic is well resolved.
+  const double h = 0.004 / xi.norm();
+  const double f0 = F(0), f1 = F(h), fm1 = F(-h), f2 = F(2 * h), fm2 = F(-2 * h);
+  const double d2 = (-f2 + 16 * f1 - 30 * f0 + 16 * fm1 - fm2) / (12 * h * h);
+  const double d3 = (f2 - 2 * f1 + 2 * fm1 - fm2) / (2 * h * h * h);
+  const double d4 = (f2 - 4 * f1 + 6 * f0 - 4 * fm1 + fm2) / (h * h * h * h);
+  EXPECT_NEAR(st.C, d2 / 2, 1e-3 * std::abs(d2 / 2));
+  EXPECT_NEAR(st.D, d3 / 6, 5e-3 * std::abs(d3 / 6));
+  EXPECT_NEAR(st.E, d4 / 24, 5e-3 * std::abs(d4 / 24));
+}
+
+TEST(LengthScale, GradientMatchesCentralDifferenceOfJ) {
+  const SolverParams p = denseParams();
+  const Pair pr = offsetPair(13, (Vector6d() << 0.01, 0.02, -0.01, 0.02, -0.01, 0.01).finished());
+  const PreparedCloud fx = prepareCloud(pr.X, p), mz = prepareCloud(pr.Z, p);
+  CrossKernel kernel(fx, mz, p);
+  auto J = [&](double ell) {
+    const auto I = Eigen::Isometry3d::Identity();
+    return test::bruteForce(pr.X, pr.X, I, ell, p).F + test::bruteForce(pr.Z, pr.Z, I, ell, p).F -
+           2 * test::bruteForce(pr.X, pr.Z, I, ell, p).F;
+  };
+  for (double ell : {0.05, 0.1, 0.14}) {
+    const CrossSums s = kernel.evaluate(Eigen::Isometry3d::Identity(), ell);
+    const SelfSums xx = selfKernelSums(fx, ell, p), yy = selfKernelSums(mz, ell, p);
+    const double analytic = (xx.sum_d2 + yy.sum_d2 - 2 * s.F_d2) / (ell * ell * ell);
+    const double h = 1e-5;
+    const double numeric = (J(ell + h) - J(ell - h)) / (2 * h);
+    EXPECT_NEAR(analytic, numeric, 1e-4 * std::abs(numeric) + 1e-6) << "ell " << ell;
+  }
+}
+
+// ---- whole registrations ------------------------------------------------------------------------
+TEST(Align, IdenticalCloudsGiveIdentityInZeroIterations) {
+  SolverParams p;
+  const LabelledCloud X = test::randomCloud(1500, 21, 0.5f);
+  const PreparedCloud fx = prepareCloud(X, p), mz = prepareCloud(X, p);
+  const CrossSums s = CrossKernel(fx, mz, p).evaluate(Eigen::Isometry3d::Identity(), 0.1);
+  EXPECT_LT(s.omega.norm(), 1e-9);
+  EXPECT_LT(s.v.norm(), 1e-9);
+  for (EllPolicy policy : {EllPolicy::kAdaptive, EllPolicy::kFixedSchedule}) {
+    p.ell_policy = policy;
+    const SolverResult r = align(fx, mz, Eigen::Isometry3d::Identity(), p);
+    EXPECT_EQ(r.status, SolverStatus::kConverged);
+    EXPECT_EQ(r.iterations, 0);
+    EXPECT_TRUE(r.transform.isApprox(Eigen::Isometry3d::Identity(), 1e-15));
+    EXPECT_NEAR(r.inner_product, 1.0, 1e-6);
+  }
+}
+
+TEST(Align, RecoversSmallMotionsOfARandomSurfaceCloud) {
+  const Vector6d motions[] = {
+      (Vector6d() << 0, 0, 0, 0.03, -0.02, 0.02).finished(),           // pure translation
+      (Vector6d() << 0.04, -0.03, 0.05, 0, 0, 0).finished(),           // pure rotation (~3.9 deg)
+      (Vector6d() << 0.03, 0.02, -0.04, -0.03, 0.02, 0.025).finished(),  // both
+  };
+  for (EllPolicy policy : {EllPolicy::kAdaptive, EllPolicy::kFixedSchedule}) {
+    SolverParams p;
+    p.ell_policy = policy;
+    p.max_iterations = 500;
+    for (const auto& m : motions) {
+      const Eigen::Isometry3d truth = expSE3(m);
+      const LabelledCloud X = test::randomCloud(3000, 31, 0.6f);
+      const LabelledCloud Z = test::transformed(X, truth.inverse());
+      const PreparedCloud fx = prepareCloud(X, p), mz = prepareCloud(Z, p);
+      const SolverResult r = align(fx, mz, Eigen::Isometry3d::Identity(), p);
+      const Vector6d err = logSE3(truth.inverse() * r.transform);
+      EXPECT_LT(err.tail<3>().norm(), 1e-3) << "policy " << int(policy) << " iterations " << r.iterations;
+      EXPECT_LT(err.head<3>().norm() * 180 / M_PI, 0.1) << "policy " << int(policy);
+    }
+  }
+}
+
+TEST(Align, LengthScaleStaysWithinBoundsAndEllMaxOnlyShrinks) {
+  SolverParams p;
+  p.max_iterations = 300;
+  const LabelledCloud X = test::randomCloud(2000, 41, 0.6f);
+  const LabelledCloud Z =
+      test::transformed(X, expSE3((Vector6d() << 0.05, 0, 0.02, 0.05, 0.03, 0).finished()));
+  const PreparedCloud fx = prepareCloud(X, p), mz = prepareCloud(Z, p);
+  for (EllUpdate update : {EllUpdate::kDescent, EllUpdate::kReference}) {
+    p.ell_update = update;
+    const SolverResult r = align(fx, mz, Eigen::Isometry3d::Identity(), p);
+    ASSERT_FALSE(r.trace.empty());
+    EXPECT_EQ(r.trace.front().ell, p.ell_init) << "ell starts from ell_init for every frame";
+    double last_max = p.ell_max;
+    for (const auto& it : r.trace) {
+      EXPECT_GE(it.ell, p.ell_min);
+      EXPECT_LE(it.ell, p.ell_max);
+      EXPECT_LE(it.ell_max, last_max);
+      last_max = it.ell_max;
+    }
+    EXPECT_GE(r.ell, p.ell_min);
+    EXPECT_LE(r.ell, last_max);
+    // A second registration starts again from the configured values.
+    const SolverResult again = align(fx, mz, Eigen::Isometry3d::Identity(), p);
+    EXPECT_EQ(again.trace.front().ell, p.ell_init);
+    EXPECT_EQ(again.iterations, r.iterations) << "registration is deterministic";
+  }
+}
+
+TEST(Align, TooFewPointsAndNonFiniteInputGiveAStatusNotNaN) {
+  SolverParams p;
+  for (int n : {0, 1, 2}) {
+    const PreparedCloud c = prepareCloud(test::randomCloud(n, 5), p);
+    const SolverResult r = align(c, c, Eigen::Isometry3d::Identity(), p);
+    EXPECT_EQ(r.status, SolverStatus::kTooFewPoints);
+    EXPECT_TRUE(r.transform.matrix().allFinite());
+  }
+  const PreparedCloud c = prepareCloud(test::randomCloud(500, 5), p);
+  Eigen::Isometry3d bad = Eigen::Isometry3d::Identity();
+  bad.translation().x() = NAN;
+  const SolverResult r = align(c, c, bad, p);
+  EXPECT_EQ(r.status, SolverStatus::kNotFinite);
+  EXPECT_TRUE(r.transform.matrix().allFinite());
+}
+
+}  // namespace
+}  // namespace acvo
