@@ -10,6 +10,7 @@
 #include <optional>
 #include <string>
 
+#include <boost/bind/bind.hpp>
 #include <boost/thread/recursive_mutex.hpp>
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <dynamic_reconfigure/server.h>
@@ -21,7 +22,7 @@
 #include <message_filters/synchronizer.h>
 #include <nav_msgs/Odometry.h>
 #include <nodelet/nodelet.h>
-#include <pluginlib/class_list_macros.h>
+#include <pluginlib/class_list_macros.hpp>
 #include <ros/ros.h>
 #include <std_srvs/Empty.h>
 #include <tf2_eigen/tf2_eigen.h>
@@ -150,7 +151,8 @@ void OdometryNodelet::onInit() {
   reconfigure_ =
       std::make_unique<dynamic_reconfigure::Server<acvo::AcvoConfig>>(reconfigure_mutex_, pnh_);
   reconfigure_->updateConfig(toConfig(params_, publish_null_when_lost_));
-  reconfigure_->setCallback(boost::bind(&OdometryNodelet::onReconfigure, this, _1, _2));
+  reconfigure_->setCallback(
+      [this](acvo::AcvoConfig& config, uint32_t level) { onReconfigure(config, level); });
 
   updater_ = std::make_unique<diagnostic_updater::Updater>(nh_, pnh_, getName());
   updater_->setHardwareID("acvo");
@@ -225,6 +227,7 @@ void OdometryNodelet::subscribe() {
   info_sub_.registerCallback(boost::function<void(const CameraInfoConstPtr&)>(
       [this](const CameraInfoConstPtr&) { ++info_count_; }));
 
+  using namespace boost::placeholders;
   const auto callback = boost::bind(&OdometryNodelet::onFrame, this, _1, _2, _3);
   if (approx) {
     approx_sync_ = std::make_unique<message_filters::Synchronizer<ApproxPolicy>>(

@@ -296,7 +296,7 @@ void expectPoseNear(const geometry_msgs::Pose& got, const Eigen::Isometry3d& wan
   const double dr = angleOf(g.rotation().transpose() * want.rotation());
   EXPECT_LT(dt, kTranslationTolerance) << what << ": translation error " << dt << " m";
   EXPECT_LT(dr, kRotationTolerance) << what << ": rotation error " << dr << " rad";
-  RecordProperty(what + "_translation_error_mm", static_cast<int>(std::lround(dt * 1000)));
+  testing::Test::RecordProperty(what + "_translation_error_mm", static_cast<int>(std::lround(dt * 1000)));
   std::cout << "[ MEASURED ] " << what << ": translation error " << dt << " m, rotation error "
             << dr << " rad\n";
 }
