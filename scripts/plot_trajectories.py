@@ -51,6 +51,11 @@ def main():
         sys.stderr.write("plot_trajectories: an input trajectory is empty\n")
         return 2
 
+    # Ground truth only over the estimate's time span (plus a second each side), so that a
+    # short estimate is not lost in a long ground truth.
+    span = [(t, p) for t, p in zip(gt_t, gt) if est_t[0] - 1.0 <= t <= est_t[-1] + 1.0]
+    if span:
+        gt_t, gt = [t for t, _ in span], [p for _, p in span]
     t0 = min(gt_t[0], est_t[0])
     fig, (plane, time) = plt.subplots(1, 2, figsize=(12, 5))
     plane.plot([p[0] for p in gt], [p[1] for p in gt], "k-", label="ground truth")

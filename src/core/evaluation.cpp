@@ -201,10 +201,9 @@ RpeResult computeRpe(const Trajectory& groundtruth, const Trajectory& estimate, 
     rot.push_back(rotationAngle(error.linear()) * 180.0 / M_PI);
   }
   if (trans.size() < 2) {
-    throw std::runtime_error(
-        "RPE: fewer than two pose pairs match between ground truth and "
-        "estimate (" +
-        std::to_string(trans.size()) + "); are the stamps from the same sequence?");
+    throw std::runtime_error("RPE: " + std::to_string(trans.size()) +
+                             " pose pairs match ground truth (at least 2 needed); are the stamps "
+                             "from the same sequence?");
   }
   RpeResult result;
   result.pairs = trans.size();
@@ -226,10 +225,9 @@ AteResult computeAte(const Trajectory& groundtruth, const Trajectory& estimate,
   }
   const std::size_t n = result.matches.size();
   if (n < 2) {
-    throw std::runtime_error(
-        "ATE: fewer than two stamps associate between ground truth and "
-        "estimate within " +
-        std::to_string(max_difference) + " s (" + std::to_string(n) + ")");
+    throw std::runtime_error("ATE: " + std::to_string(n) + " estimate stamps are within " +
+                             std::to_string(max_difference) +
+                             " s of a ground-truth stamp (at least 2 needed)");
   }
   Eigen::Matrix3Xd est_points(3, n), gt_points(3, n);
   for (std::size_t k = 0; k < n; ++k) {

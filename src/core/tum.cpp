@@ -30,6 +30,7 @@ std::vector<Line> readDataLines(const std::string& path) {
   std::vector<Line> lines;
   std::string text;
   for (int number = 1; std::getline(in, text); ++number) {
+    if (!text.empty() && text.back() == '\r') text.pop_back();  // CRLF files
     const auto first = text.find_first_not_of(" \t\r");
     if (first == std::string::npos || text[first] == '#') continue;
     lines.push_back({number, text});
@@ -96,8 +97,9 @@ std::vector<TumAssociation> readAssociations(const std::string& path) {
   std::vector<TumAssociation> associations;
   for (const Line& line : readDataLines(path)) {
     const auto f = splitFields(line.text);
-    if (f.size() != 4)
+    if (f.size() != 4) {
       malformed(path, line, "expected 'rgb_stamp rgb_path depth_stamp depth_path'");
+    }
     associations.push_back(
         {{f[0], parseStamp(path, line, f[0]), f[1]}, {f[2], parseStamp(path, line, f[2]), f[3]}});
   }
@@ -174,8 +176,11 @@ TumDataset::TumDataset(const std::string& folder, const std::string& camera) : f
     camera_ = fs::exists(yaml) ? loadCameraYaml(yaml.string()) : cameraByName("default");
   } else if (camera == "fr1" || camera == "fr2" || camera == "fr3" || camera == "default") {
     camera_ = cameraByName(camera);
+  } else if (fs::exists(camera)) {
+    camera_ = loadCameraYaml(camera);
   } else {
-    camera_ = loadCameraYaml(camera);  // throws naming the file when it is missing
+    throw std::runtime_error("camera '" + camera +
+                             "' is neither fr1, fr2, fr3, default nor a camera yaml file");
   }
 
   const fs::path associations = dir / "associations.txt";
