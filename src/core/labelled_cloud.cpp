@@ -1,0 +1,89 @@
+#include "acvo/labelled_cloud.hpp"
+
+#include <chrono>
+#include <stdexcept>
+
+#include <opencv2/imgproc.hpp>
+
+#include "acvo/hsv.hpp"
+
+namespace acvo {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double msSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+cv::Mat grayOf(const Frame& frame) {
+  if (frame.order == ColorOrder::kGray) return frame.color;
+  cv::Mat gray;
+  cv::cvtColor(frame.color, gray,
+               frame.order == ColorOrder::kRgb ? cv::COLOR_RGB2GRAY : cv::COLOR_BGR2GRAY);
+  return gray;
+}
+
+// R, G, B of one pixel whatever the frame's channel order (grey replicated).
+std::array<std::uint8_t, 3> rgbAt(const Frame& frame, int u, int v) {
+  if (frame.order == ColorOrder::kGray) {
+    const std::uint8_t i = frame.color.at<std::uint8_t>(v, u);
+    return {i, i, i};
+  }
+  const auto& c = frame.color.at<cv::Vec3b>(v, u);
+  if (frame.order == ColorOrder::kRgb) return {c[0], c[1], c[2]};
+  return {c[2], c[1], c[0]};
+}
+
+}  // namespace
+
+LabelledCloud buildLabelledCloud(const Frame& frame, const SelectionParams& params,
+                                 CloudStats* stats) {
+  if (const std::string why = frame.problem(); !why.empty()) {
+    throw std::invalid_argument("buildLabelledCloud: " + why);
+  }
+  // ms_selection counts the grey conversion too: it exists only for selection and gradients.
+  const auto t0 = Clock::now();
+  const cv::Mat gray = grayOf(frame);
+  Selection selection = selectPixels(gray, frame.depth, params);
+  const double ms_selection = msSince(t0);
+
+  // HSV only at the kept pixels: converting the whole image would cost more than the rest.
+  const auto t1 = Clock::now();
+  LabelledCloud cloud;
+  cloud.stamp = frame.stamp;
+  cloud.width = frame.color.cols;
+  cloud.height = frame.color.rows;
+  cloud.pixels = std::move(selection.pixels);
+  const std::size_t n = cloud.pixels.size();
+  cloud.points.reserve(n);
+  cloud.labels.reserve(n);
+  cloud.rgb.reserve(n);
+  const Camera& cam = frame.camera;
+  for (const cv::Point& p : cloud.pixels) {
+    const double z = frame.depth.at<float>(p.y, p.x);
+    cloud.points.emplace_back(cam.backProject(p.x, p.y, z).cast<float>());
+
+    const std::array<std::uint8_t, 3> rgb = rgbAt(frame, p.x, p.y);
+    cloud.rgb.push_back(rgb);
+    const std::array<std::uint8_t, 3> hsv = rgbToHsv(rgb[0], rgb[1], rgb[2]);
+    // Selected pixels keep a 4-pixel border, so both neighbours exist.
+    const auto* row = gray.ptr<std::uint8_t>(p.y);
+    const float dx = static_cast<float>(row[p.x + 1]) - static_cast<float>(row[p.x - 1]);
+    const float dy = static_cast<float>(gray.ptr<std::uint8_t>(p.y + 1)[p.x]) -
+                     static_cast<float>(gray.ptr<std::uint8_t>(p.y - 1)[p.x]);
+    Label label;
+    // gx = dx / 2, normalised as gx / 255 * 2 = dx / 255.
+    label << hsv[0] / 180.f, hsv[1] / 255.f, hsv[2] / 255.f, dx / 255.f, dy / 255.f;
+    cloud.labels.push_back(label);
+  }
+  if (stats) {
+    stats->selection = std::move(selection);
+    stats->selection.pixels.clear();
+    stats->ms_selection = ms_selection;
+    stats->ms_labels = msSince(t1);
+  }
+  return cloud;
+}
+
+}  // namespace acvo

@@ -1,0 +1,139 @@
+// acvo_eval end to end: the built tool on the hand-checkable fixtures.
+#include <sys/wait.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "test_support.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct ToolRun {
+  int status = -1;
+  std::string output;  // stdout only
+  std::string lastLine() const {
+    std::istringstream lines(output);
+    std::string line, last;
+    while (std::getline(lines, line)) {
+      if (!line.empty()) last = line;
+    }
+    return last;
+  }
+};
+
+ToolRun runTool(const std::string& arguments, const std::string& environment = "") {
+  const fs::path tool = acvo::test::toolsDir() / "acvo_eval";
+  ToolRun run;
+  if (!fs::exists(tool)) {
+    ADD_FAILURE() << tool << " is not built";
+    return run;
+  }
+  FILE* pipe =
+      popen((environment + " '" + tool.string() + "' " + arguments + " 2>/dev/null").c_str(), "r");
+  if (!pipe) return run;
+  char buffer[4096];
+  for (std::size_t n; (n = std::fread(buffer, 1, sizeof(buffer), pipe)) > 0;) {
+    run.output.append(buffer, n);
+  }
+  const int status = pclose(pipe);
+  run.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return run;
+}
+
+std::string fixtureArgs(const std::string& gt, const std::string& est) {
+  const fs::path dir = acvo::test::sourceDir() / "test/data/eval";
+  return "--groundtruth '" + (dir / gt).string() + "' --estimate '" + (dir / est).string() + "'";
+}
+
+// The figure after "key=" in the summary line.
+double figure(const std::string& line, const std::string& key) {
+  const auto at = line.find(key + "=");
+  if (at == std::string::npos) {
+    ADD_FAILURE() << "no " << key << " in '" << line << "'";
+    return NAN;
+  }
+  return std::stod(line.substr(at + key.size() + 1));
+}
+
+TEST(AcvoEval, SummaryLineCarriesTheFigures) {
+  // line_drift: 10 % too fast along a straight line (test/data/eval/README.md).
+  const ToolRun run = runTool(fixtureArgs("line_gt.txt", "line_drift.txt"));
+  ASSERT_EQ(run.status, 0) << run.output;
+  const std::string last = run.lastLine();
+  EXPECT_EQ(last.rfind("rpe_trans_rmse=", 0), 0u) << last;
+  EXPECT_NEAR(figure(last, "rpe_trans_rmse"), 0.05, 1e-6);
+  EXPECT_NEAR(figure(last, "rpe_rot_rmse_deg"), 0.0, 1e-5);
+  EXPECT_NEAR(figure(last, "ate_rmse"), 0.005 * std::sqrt(80.0), 1e-6);
+  EXPECT_EQ(figure(last, "pairs"), 20.0);
+  EXPECT_NE(run.output.find("translational_error.rmse 0.050000 m"), std::string::npos)
+      << run.output;
+  EXPECT_NE(run.output.find("absolute_translational_error.max 0.075000 m"), std::string::npos)
+      << run.output;
+}
+
+TEST(AcvoEval, DeltaUnitAndJson) {
+  const fs::path json = acvo::test::tempDir("acvo_eval_json") / "eval.json";
+  const ToolRun run = runTool(fixtureArgs("spin_gt.txt", "spin_drift.txt") +
+                              " --delta 10 --delta-unit deg --json '" + json.string() + "'");
+  ASSERT_EQ(run.status, 0) << run.output;
+  EXPECT_NEAR(figure(run.lastLine(), "rpe_rot_rmse_deg"), 0.035 * 180.0 / M_PI, 1e-6);
+  EXPECT_EQ(figure(run.lastLine(), "pairs"), 23.0);
+  std::ifstream in(json);
+  std::stringstream text;
+  text << in.rdbuf();
+  EXPECT_NE(text.str().find("\"delta_unit\": \"deg\""), std::string::npos) << text.str();
+  EXPECT_NE(text.str().find("\"pairs\": 23"), std::string::npos) << text.str();
+  EXPECT_NE(text.str().find("\"alignment\""), std::string::npos) << text.str();
+}
+
+TEST(AcvoEval, BadInputExitsWithTwo) {
+  EXPECT_EQ(runTool(fixtureArgs("line_gt.txt", "absent.txt")).status, 2);
+  EXPECT_EQ(runTool("--estimate x").status, 2);
+  EXPECT_EQ(runTool(fixtureArgs("line_gt.txt", "line_drift.txt") + " --delta-unit km").status, 2);
+  const fs::path bad = acvo::test::tempDir("acvo_eval_bad") / "bad.txt";
+  std::ofstream(bad) << "1.0 0 0 0 0 0 0 1\n2.0 0 0 0 0 0 1\n";
+  const fs::path dir = acvo::test::sourceDir() / "test/data/eval";
+  EXPECT_EQ(runTool("--groundtruth '" + (dir / "line_gt.txt").string() + "' --estimate '" +
+                    bad.string() + "'")
+                .status,
+            2);
+  const ToolRun help = runTool("--help");
+  EXPECT_EQ(help.status, 0);
+  EXPECT_NE(help.output.find("usage: acvo_eval"), std::string::npos);
+}
+
+TEST(AcvoEval, PlotWritesAPng) {
+  if (std::system("/usr/bin/python3 -c 'import matplotlib' >/dev/null 2>&1") != 0) {
+    GTEST_SKIP() << "/usr/bin/python3 with matplotlib is not available";
+  }
+  const fs::path png = acvo::test::tempDir("acvo_eval_plot") / "plot.png";
+  const ToolRun run =
+      runTool(fixtureArgs("arc_gt.txt", "arc_drift.txt") + " --plot '" + png.string() + "'");
+  ASSERT_EQ(run.status, 0) << run.output;
+  EXPECT_EQ(run.lastLine().rfind("rpe_trans_rmse=", 0), 0u);
+  std::ifstream in(png, std::ios::binary);
+  char signature[8] = {};
+  in.read(signature, 8);
+  EXPECT_EQ(std::string(signature + 1, 3), "PNG");
+  EXPECT_GT(fs::file_size(png), 10000u);
+}
+
+TEST(AcvoEval, FailedPlotStillReportsAndExitsWithThree) {
+  const fs::path png = acvo::test::tempDir("acvo_eval_no_plot") / "plot.png";
+  const ToolRun run =
+      runTool(fixtureArgs("line_gt.txt", "line_drift.txt") + " --plot '" + png.string() + "'",
+              "ACVO_PLOT_SCRIPT=/nonexistent/plot_trajectories.py");
+  EXPECT_EQ(run.status, 3);
+  EXPECT_NEAR(figure(run.lastLine(), "rpe_trans_rmse"), 0.05, 1e-6);
+  EXPECT_FALSE(fs::exists(png));
+}
+
+}  // namespace

@@ -1,0 +1,143 @@
+// Camera intrinsics: TUM names, YAML load/save, validation, projection.
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "acvo/camera.hpp"
+#include "test_support.hpp"
+
+namespace {
+
+using acvo::Camera;
+
+void writeText(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream(path) << text;
+}
+
+// The message of the std::runtime_error `f` throws (fails the test when it throws none).
+template <typename F>
+std::string errorOf(F f) {
+  try {
+    f();
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no std::runtime_error thrown";
+  return {};
+}
+
+TEST(Camera, TumNamesGiveThePublishedIntrinsics) {
+  const Camera fr1 = acvo::cameraByName("fr1");
+  EXPECT_DOUBLE_EQ(fr1.fx, 517.3);
+  EXPECT_DOUBLE_EQ(fr1.fy, 516.5);
+  EXPECT_DOUBLE_EQ(fr1.cx, 318.6);
+  EXPECT_DOUBLE_EQ(fr1.cy, 255.3);
+  const Camera fr2 = acvo::cameraByName("fr2");
+  EXPECT_DOUBLE_EQ(fr2.fx, 520.9);
+  EXPECT_DOUBLE_EQ(fr2.cy, 249.7);
+  const Camera fr3 = acvo::cameraByName("fr3");
+  EXPECT_DOUBLE_EQ(fr3.fx, 535.4);
+  EXPECT_DOUBLE_EQ(fr3.fy, 539.2);
+  const Camera def = acvo::cameraByName("default");
+  EXPECT_DOUBLE_EQ(def.fx, 525.0);
+  EXPECT_DOUBLE_EQ(def.cx, 319.5);
+  EXPECT_DOUBLE_EQ(def.cy, 239.5);
+  for (const char* name : {"fr1", "fr2", "fr3", "default"}) {
+    const Camera c = acvo::cameraByName(name);
+    EXPECT_EQ(c.width, 640) << name;
+    EXPECT_EQ(c.height, 480) << name;
+    EXPECT_DOUBLE_EQ(c.depth_scale, 5000.0) << name;
+    EXPECT_TRUE(c.valid()) << name;
+  }
+}
+
+TEST(Camera, UnknownNameThrows) {
+  EXPECT_THROW(acvo::cameraByName("fr4"), std::invalid_argument);
+  EXPECT_THROW(acvo::cameraByName(""), std::invalid_argument);
+}
+
+TEST(Camera, YamlRoundTripIsExact) {
+  const auto dir = acvo::test::tempDir("camera_roundtrip");
+  Camera c;
+  c.fx = 585.123456789012;
+  c.fy = 584.9876543210987;
+  c.cx = 320.1 / 3.0;
+  c.cy = 239.75;
+  c.width = 320;
+  c.height = 240;
+  c.depth_scale = 1000.0;
+  acvo::saveCameraYaml((dir / "camera.yaml").string(), c);
+  const Camera r = acvo::loadCameraYaml((dir / "camera.yaml").string());
+  EXPECT_EQ(r.fx, c.fx);
+  EXPECT_EQ(r.fy, c.fy);
+  EXPECT_EQ(r.cx, c.cx);
+  EXPECT_EQ(r.cy, c.cy);
+  EXPECT_EQ(r.width, c.width);
+  EXPECT_EQ(r.height, c.height);
+  EXPECT_EQ(r.depth_scale, c.depth_scale);
+}
+
+TEST(Camera, YamlDepthScaleDefaultsToTumPng) {
+  const auto dir = acvo::test::tempDir("camera_default_scale");
+  writeText(dir / "c.yaml", "fx: 500\nfy: 501\ncx: 300\ncy: 200\nwidth: 600\nheight: 400\n");
+  const Camera c = acvo::loadCameraYaml((dir / "c.yaml").string());
+  EXPECT_DOUBLE_EQ(c.fx, 500.0);
+  EXPECT_DOUBLE_EQ(c.fy, 501.0);
+  EXPECT_EQ(c.width, 600);
+  EXPECT_DOUBLE_EQ(c.depth_scale, 5000.0);
+}
+
+TEST(Camera, YamlProblemsNameTheFileAndTheKey) {
+  const auto dir = acvo::test::tempDir("camera_invalid");
+  const std::string missing_key = (dir / "missing.yaml").string();
+  writeText(missing_key, "fx: 500\nfy: 501\ncx: 300\nwidth: 600\nheight: 400\n");
+  std::string why = errorOf([&] { acvo::loadCameraYaml(missing_key); });
+  EXPECT_NE(why.find(missing_key), std::string::npos) << why;
+  EXPECT_NE(why.find("cy"), std::string::npos) << why;
+
+  const std::string not_number = (dir / "text.yaml").string();
+  writeText(not_number, "fx: wide\nfy: 501\ncx: 300\ncy: 200\nwidth: 600\nheight: 400\n");
+  why = errorOf([&] { acvo::loadCameraYaml(not_number); });
+  EXPECT_NE(why.find("fx"), std::string::npos) << why;
+
+  const std::string negative = (dir / "negative.yaml").string();
+  writeText(negative, "fx: -500\nfy: 501\ncx: 300\ncy: 200\nwidth: 600\nheight: 400\n");
+  why = errorOf([&] { acvo::loadCameraYaml(negative); });
+  EXPECT_NE(why.find(negative), std::string::npos) << why;
+
+  const std::string absent = (dir / "absent.yaml").string();
+  why = errorOf([&] { acvo::loadCameraYaml(absent); });
+  EXPECT_NE(why.find(absent), std::string::npos) << why;
+}
+
+TEST(Camera, ValidRejectsNonPositiveAndNonFinite) {
+  Camera c;
+  EXPECT_TRUE(c.valid());
+  c.fx = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(c.valid());
+  c = Camera();
+  c.fy = 0.0;
+  EXPECT_FALSE(c.valid());
+  c = Camera();
+  c.width = 0;
+  EXPECT_FALSE(c.valid());
+  c = Camera();
+  c.depth_scale = -1.0;
+  EXPECT_FALSE(c.valid());
+}
+
+TEST(Camera, ProjectInvertsBackProject) {
+  const Camera c = acvo::cameraByName("fr1");
+  const Eigen::Vector3d p = c.backProject(100.25, 400.5, 2.5);
+  EXPECT_DOUBLE_EQ(p.z(), 2.5);
+  EXPECT_NEAR(p.x(), (100.25 - 318.6) * 2.5 / 517.3, 1e-12);
+  const Eigen::Vector2d uv = c.project(p);
+  EXPECT_NEAR(uv.x(), 100.25, 1e-9);
+  EXPECT_NEAR(uv.y(), 400.5, 1e-9);
+}
+
+}  // namespace

@@ -1,0 +1,242 @@
+// The parameter table: config/acvo.yaml carries the struct's defaults, every key is wired, and
+// mistakes in a YAML file are reported with the file and the key.
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <type_traits>
+
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include "acvo/params.hpp"
+#include "test_support.hpp"
+
+namespace acvo {
+namespace {
+
+// Every parameter as "section.name" -> exact text (doubles in hexadecimal, so equal text means
+// equal bits).
+std::map<std::string, std::string> flatten(const Params& p) {
+  std::map<std::string, std::string> out;
+  visitParams(p, [&out](const char* section, const char* name, const auto& field) {
+    using T = std::decay_t<decltype(field)>;
+    std::string text;
+    if constexpr (std::is_enum_v<T>) {
+      text = toString(field);
+    } else if constexpr (std::is_same_v<T, bool>) {
+      text = field ? "true" : "false";
+    } else if constexpr (std::is_same_v<T, int>) {
+      text = std::to_string(field);
+    } else {
+      char buf[64];
+      std::snprintf(buf, sizeof buf, "%a", field);
+      text = buf;
+    }
+    out[std::string(section) + "." + name] = text;
+  });
+  return out;
+}
+
+std::string expectThrowMessage(const std::string& yaml) {
+  try {
+    parseParams(yaml, Params(), "test.yaml");
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no exception for:\n" << yaml;
+  return {};
+}
+
+TEST(Params, ConfigFileHoldsEveryKeyWithTheStructDefaults) {
+  const std::string path = (test::sourceDir() / "config" / "acvo.yaml").string();
+  const Params loaded = loadParams(path);
+  const auto got = flatten(loaded);
+  const auto want = flatten(Params());
+  ASSERT_EQ(got.size(), 25u);
+  EXPECT_EQ(got, want);
+  // Equal values could also come from keys missing in the file: check each key is written.
+  const YAML::Node file = YAML::LoadFile(path);
+  visitParams(loaded, [&file](const char* section, const char* name, const auto&) {
+    EXPECT_TRUE(file[section] && file[section][name]) << section << "." << name << " missing";
+  });
+}
+
+TEST(Params, EveryKeyIsReadIntoItsField) {
+  const Params defaults;
+  visitParams(defaults, [&defaults](const char* section, const char* name, const auto& field) {
+    using T = std::decay_t<decltype(field)>;
+    std::string value;
+    if constexpr (std::is_same_v<T, EllPolicy>) {
+      value = toString(field == EllPolicy::kAdaptive ? EllPolicy::kFixedSchedule
+                                                     : EllPolicy::kAdaptive);
+    } else if constexpr (std::is_same_v<T, EllUpdate>) {
+      value = toString(field == EllUpdate::kDescent ? EllUpdate::kReference : EllUpdate::kDescent);
+    } else if constexpr (std::is_same_v<T, InitialGuess>) {
+      value = toString(field == InitialGuess::kIdentity ? InitialGuess::kConstantVelocity
+                                                        : InitialGuess::kIdentity);
+    } else if constexpr (std::is_same_v<T, bool>) {
+      value = field ? "false" : "true";
+    } else if constexpr (std::is_same_v<T, int>) {
+      value = std::to_string(field + 1);
+    } else {
+      char buf[64];
+      std::snprintf(buf, sizeof buf, "%.17g", field * 1.01);  // stays valid for every field
+      value = buf;
+    }
+    const std::string key = std::string(section) + "." + name;
+    const Params p =
+        parseParams(std::string(section) + ":\n  " + name + ": " + value + "\n", defaults);
+    auto changed = flatten(p);
+    auto original = flatten(defaults);
+    EXPECT_NE(changed[key], original[key]) << key << " was not read";
+    changed.erase(key);
+    original.erase(key);
+    EXPECT_EQ(changed, original) << key << " changed another field";
+  });
+}
+
+TEST(Params, ValuesOverrideTheBase) {
+  const Params p = parseParams(
+      "selection:\n  target_points: 1500\n  canny_fallback: false\n"
+      "solver:\n  ell_update: reference\n  color_ell: 0.1\n"
+      "odometry:\n  initial_guess: identity\n  threads: 2\n");
+  EXPECT_EQ(p.selection.target_points, 1500);
+  EXPECT_FALSE(p.selection.canny_fallback);
+  EXPECT_EQ(p.solver.ell_update, EllUpdate::kReference);
+  EXPECT_DOUBLE_EQ(p.solver.color_ell, 0.1);
+  EXPECT_EQ(p.odometry.initial_guess, InitialGuess::kIdentity);
+  EXPECT_EQ(p.odometry.threads, 2);
+  EXPECT_DOUBLE_EQ(p.solver.ell_init, Params().solver.ell_init);
+  // An empty text keeps the base.
+  EXPECT_EQ(flatten(parseParams("", p)), flatten(p));
+}
+
+TEST(Params, UnknownKeyIsRejectedByName) {
+  const std::string msg = expectThrowMessage("solver:\n  ell_initial: 0.1\n");
+  EXPECT_NE(msg.find("solver.ell_initial"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("test.yaml"), std::string::npos) << msg;
+  // A key of another section is unknown in this one.
+  const std::string other = expectThrowMessage("selection:\n  sigma: 0.1\n");
+  EXPECT_NE(other.find("selection.sigma"), std::string::npos) << other;
+}
+
+TEST(Params, UnknownSectionIsRejectedByName) {
+  const std::string msg = expectThrowMessage("slover:\n  sigma: 0.1\n");
+  EXPECT_NE(msg.find("slover"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("test.yaml"), std::string::npos) << msg;
+}
+
+TEST(Params, WrongTypesAreRejectedByName) {
+  const std::map<std::string, std::string> cases = {
+      {"selection:\n  target_points: lots\n", "selection.target_points"},
+      {"selection:\n  target_points: 2.5\n", "selection.target_points"},
+      {"selection:\n  canny_fallback: 3\n", "selection.canny_fallback"},
+      {"solver:\n  sigma: abc\n", "solver.sigma"},
+      {"solver:\n  sigma: [0.1, 0.2]\n", "solver.sigma"},
+      {"solver:\n  ell_policy: sideways\n", "solver.ell_policy"},
+      {"odometry:\n  initial_guess: 1\n", "odometry.initial_guess"},
+      {"solver: 3\n", "solver"},
+      {"- a\n- b\n", "sections"},
+  };
+  for (const auto& [yaml, key] : cases) {
+    const std::string msg = expectThrowMessage(yaml);
+    EXPECT_NE(msg.find(key), std::string::npos) << yaml << " -> " << msg;
+  }
+  const std::string msg = expectThrowMessage("solver:\n  ell_policy: sideways\n");
+  EXPECT_NE(msg.find("fixed_schedule"), std::string::npos) << "accepted values listed: " << msg;
+}
+
+TEST(Params, LoadNamesTheFile) {
+  const auto dir = test::tempDir("params");
+  const std::string path = (dir / "bad.yaml").string();
+  std::ofstream(path) << "solver:\n  ell_min: 0.2\n  ell_max: 0.1\n";
+  try {
+    loadParams(path);
+    ADD_FAILURE() << "inconsistent file accepted";
+  } catch (const std::runtime_error& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find(path), std::string::npos) << msg;
+    EXPECT_NE(msg.find("ell_min"), std::string::npos) << msg;
+  }
+  const std::string missing = (dir / "missing.yaml").string();
+  try {
+    loadParams(missing);
+    ADD_FAILURE() << "missing file accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(missing), std::string::npos) << e.what();
+  }
+  const std::string broken = (dir / "broken.yaml").string();
+  std::ofstream(broken) << "solver: [unclosed\n";
+  EXPECT_THROW(loadParams(broken), std::runtime_error);
+}
+
+TEST(Params, EnumStringsRoundTrip) {
+  for (EllPolicy v : {EllPolicy::kAdaptive, EllPolicy::kFixedSchedule}) {
+    EllPolicy back = v == EllPolicy::kAdaptive ? EllPolicy::kFixedSchedule : EllPolicy::kAdaptive;
+    fromString(toString(v), back);
+    EXPECT_EQ(back, v);
+  }
+  for (EllUpdate v : {EllUpdate::kDescent, EllUpdate::kReference}) {
+    EllUpdate back = v == EllUpdate::kDescent ? EllUpdate::kReference : EllUpdate::kDescent;
+    fromString(toString(v), back);
+    EXPECT_EQ(back, v);
+  }
+  for (InitialGuess v : {InitialGuess::kConstantVelocity, InitialGuess::kIdentity}) {
+    InitialGuess back =
+        v == InitialGuess::kIdentity ? InitialGuess::kConstantVelocity : InitialGuess::kIdentity;
+    fromString(toString(v), back);
+    EXPECT_EQ(back, v);
+  }
+  EXPECT_EQ(toString(EllPolicy::kAdaptive), "adaptive");
+  EXPECT_EQ(toString(EllPolicy::kFixedSchedule), "fixed_schedule");
+  EXPECT_EQ(toString(EllUpdate::kDescent), "descent");
+  EXPECT_EQ(toString(EllUpdate::kReference), "reference");
+  EXPECT_EQ(toString(InitialGuess::kConstantVelocity), "constant_velocity");
+  EXPECT_EQ(toString(InitialGuess::kIdentity), "identity");
+  EllUpdate u = EllUpdate::kDescent;
+  EXPECT_THROW(fromString("Reference", u), std::invalid_argument);
+  EXPECT_EQ(u, EllUpdate::kDescent);
+}
+
+TEST(Params, ValidateCatchesInconsistentValues) {
+  EXPECT_EQ(validate(Params()), "");
+  auto message = [](auto change) {
+    Params p;
+    change(p);
+    return validate(p);
+  };
+  EXPECT_NE(message([](Params& p) { p.solver.ell_min = 0.2; }).find("ell_min"), std::string::npos);
+  EXPECT_NE(message([](Params& p) { p.solver.sigma = 0.0; }).find("sigma"), std::string::npos);
+  EXPECT_NE(message([](Params& p) { p.solver.sigma = -0.1; }).find("sigma"), std::string::npos);
+  EXPECT_NE(message([](Params& p) { p.solver.color_sigma = 0.0; }).find("color_sigma"),
+            std::string::npos);
+  EXPECT_NE(message([](Params& p) { p.selection.target_points = 0; }).find("target_points"),
+            std::string::npos);
+  EXPECT_NE(message([](Params& p) { p.selection.target_points = -5; }).find("target_points"),
+            std::string::npos);
+  EXPECT_NE(message([](Params& p) { p.selection.min_depth = 6.0; }).find("min_depth"),
+            std::string::npos);
+  EXPECT_NE(message([](Params& p) { p.selection.min_depth = 7.0; }).find("min_depth"),
+            std::string::npos);
+  EXPECT_NE(message([](Params& p) {
+              p.solver.ell_init = std::numeric_limits<double>::quiet_NaN();
+            }).find("solver.ell_init"),
+            std::string::npos);
+  EXPECT_NE(message([](Params& p) { p.solver.max_step = 0.1; }).find("min_step"),
+            std::string::npos);
+  EXPECT_NE(message([](Params& p) { p.odometry.threads = -1; }).find("threads"), std::string::npos);
+  // The YAML loader applies the same checks.
+  const std::string msg = expectThrowMessage("solver:\n  sigma: -1\n");
+  EXPECT_NE(msg.find("solver.sigma"), std::string::npos) << msg;
+}
+
+}  // namespace
+}  // namespace acvo
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  return RUN_ALL_TESTS();
+}

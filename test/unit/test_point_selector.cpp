@@ -1,0 +1,264 @@
+// Properties of the DSO-style selection (method.md §1): determinism, count near the target,
+// border and depth rules, Canny fallback.
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <limits>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "acvo/depth.hpp"
+#include "acvo/point_selector.hpp"
+#include "test_support.hpp"
+
+namespace acvo {
+namespace {
+
+// Multi-scale value noise: uniform noise at several scales, upsampled and summed, so every
+// block has texture at several frequencies (like a real scene, unlike white noise).
+cv::Mat texturedImage(int width, int height, std::uint64_t seed) {
+  cv::RNG rng(seed);
+  cv::Mat sum(height, width, CV_32FC1, cv::Scalar(0));
+  float weight = 1.f;
+  for (int cell : {64, 16, 4, 1}) {
+    cv::Mat coarse(height / cell + 2, width / cell + 2, CV_32FC1);
+    rng.fill(coarse, cv::RNG::UNIFORM, 0.f, 1.f);
+    cv::Mat up;
+    cv::resize(coarse, up, cv::Size(coarse.cols * cell, coarse.rows * cell), 0, 0,
+               cv::INTER_LINEAR);
+    sum += weight * up(cv::Rect(0, 0, width, height));
+    weight *= 0.6f;
+  }
+  cv::Mat gray;
+  cv::normalize(sum, sum, 0, 255, cv::NORM_MINMAX);
+  sum.convertTo(gray, CV_8UC1);
+  return gray;
+}
+
+cv::Mat constantDepth(cv::Size size, float metres) {
+  return cv::Mat(size, CV_32FC1, cv::Scalar(metres));
+}
+
+bool isRowMajor(const std::vector<cv::Point>& px) {
+  for (std::size_t i = 1; i < px.size(); ++i) {
+    const cv::Point a = px[i - 1], b = px[i];
+    if (!(a.y < b.y || (a.y == b.y && a.x < b.x))) return false;
+  }
+  return true;
+}
+
+TEST(PointSelector, SameImageGivesSamePixelsInRowMajorOrder) {
+  const cv::Mat gray = texturedImage(640, 480, 7);
+  const cv::Mat depth = constantDepth(gray.size(), 2.f);
+  const Selection a = selectPixels(gray, depth, SelectionParams());
+  const Selection b = selectPixels(gray.clone(), depth.clone(), SelectionParams());
+  ASSERT_FALSE(a.pixels.empty());
+  EXPECT_EQ(a.pixels, b.pixels);
+  EXPECT_EQ(a.cell_size, b.cell_size);
+  EXPECT_TRUE(isRowMajor(a.pixels));
+}
+
+TEST(PointSelector, CountOnTexturedImageIsWithinFivePercentOfTarget) {
+  for (std::uint64_t seed : {1, 2, 3}) {
+    for (int target : {3000, 1500}) {
+      SCOPED_TRACE("seed " + std::to_string(seed) + ", target " + std::to_string(target));
+      const cv::Mat gray = texturedImage(640, 480, seed);
+      SelectionParams params;
+      params.target_points = target;
+      const Selection s = selectPixels(gray, constantDepth(gray.size(), 2.f), params);
+      EXPECT_NEAR(static_cast<double>(s.pixels.size()), target, 0.05 * target);
+      EXPECT_EQ(static_cast<int>(s.pixels.size()), s.gradient_pixels);
+      EXPECT_FALSE(s.canny_used);
+      EXPECT_GE(s.cell_size, 1);
+    }
+  }
+}
+
+TEST(PointSelector, BorderIsNeverSelected) {
+  // Strong gradients right at the edge of the image: the frame would attract the selector.
+  cv::Mat gray = texturedImage(320, 240, 11);
+  gray.colRange(0, 5).setTo(255);
+  gray.rowRange(0, 5).setTo(0);
+  gray.colRange(315, 320).setTo(0);
+  gray.rowRange(235, 240).setTo(255);
+  const Selection s = selectPixels(gray, constantDepth(gray.size(), 2.f), SelectionParams());
+  ASSERT_FALSE(s.pixels.empty());
+  for (const cv::Point& p : s.pixels) {
+    ASSERT_GE(p.x, 4);
+    ASSERT_GE(p.y, 4);
+    ASSERT_LT(p.x, gray.cols - 4);
+    ASSERT_LT(p.y, gray.rows - 4);
+  }
+}
+
+TEST(PointSelector, InvalidDepthIsDroppedAfterSelection) {
+  const cv::Mat gray = texturedImage(640, 480, 5);
+  SelectionParams params;  // depth range [0.1, 6]
+  cv::Mat depth = constantDepth(gray.size(), 2.f);
+  depth.colRange(0, 128).setTo(0.f);
+  depth.colRange(128, 256).setTo(std::numeric_limits<float>::quiet_NaN());
+  depth.colRange(256, 384).setTo(0.05f);  // nearer than min_depth
+  depth.colRange(384, 512).setTo(10.f);   // farther than max_depth
+  depth.at<float>(240, 600) = 6.f;        // exactly max_depth: kept if selected
+  depth.at<float>(100, 520) = 0.1f;       // exactly min_depth
+  depth.rowRange(300, 480).colRange(512, 640).setTo(std::numeric_limits<float>::infinity());
+
+  const Selection all_valid = selectPixels(gray, constantDepth(gray.size(), 2.f), params);
+  const Selection s = selectPixels(gray, depth, params);
+  // The selection itself does not look at depth: the same candidates, then filtered.
+  EXPECT_EQ(s.gradient_pixels, all_valid.gradient_pixels);
+  std::vector<cv::Point> expected;
+  for (const cv::Point& p : all_valid.pixels) {
+    const float d = depth.at<float>(p);
+    if (d >= 0.1f && d <= 6.f) expected.push_back(p);
+  }
+  EXPECT_EQ(s.pixels, expected);
+  ASSERT_FALSE(s.pixels.empty());
+  for (const cv::Point& p : s.pixels) {
+    const float d = depth.at<float>(p);
+    ASSERT_TRUE(std::isfinite(d));
+    ASSERT_GE(d, 0.1f);
+    ASSERT_LE(d, 6.f);
+    ASSERT_GE(p.x, 512);
+  }
+}
+
+// A few flat rectangles whose edges are too weak for the gradient threshold (|grad I| = 5 is
+// below the threshold of 7 of flat blocks) but strong enough for Canny's high threshold.
+cv::Mat flatRectangles() {
+  cv::Mat gray(480, 640, CV_8UC1, cv::Scalar(100));
+  gray(cv::Rect(100, 80, 120, 90)).setTo(110);
+  gray(cv::Rect(350, 200, 150, 100)).setTo(90);
+  gray(cv::Rect(150, 320, 60, 60)).setTo(110);
+  return gray;
+}
+
+bool nearRectangleEdge(const cv::Point& p) {
+  for (const cv::Rect& r :
+       {cv::Rect(100, 80, 120, 90), cv::Rect(350, 200, 150, 100), cv::Rect(150, 320, 60, 60)}) {
+    const bool near_x = std::abs(p.x - r.x) <= 2 || std::abs(p.x - (r.x + r.width)) <= 2;
+    const bool near_y = std::abs(p.y - r.y) <= 2 || std::abs(p.y - (r.y + r.height)) <= 2;
+    const bool in_x = p.x >= r.x - 2 && p.x <= r.x + r.width + 2;
+    const bool in_y = p.y >= r.y - 2 && p.y <= r.y + r.height + 2;
+    if ((near_x && in_y) || (near_y && in_x)) return true;
+  }
+  return false;
+}
+
+TEST(PointSelector, CannyFallbackAddsEdgePixelsOnLowTexture) {
+  const cv::Mat gray = flatRectangles();
+  const cv::Mat depth = constantDepth(gray.size(), 2.f);
+  SelectionParams params;
+  params.canny_fallback = false;
+  const Selection without = selectPixels(gray, depth, params);
+  params.canny_fallback = true;
+  const Selection with = selectPixels(gray, depth, params);
+
+  EXPECT_FALSE(without.canny_used);
+  EXPECT_EQ(without.canny_pixels, 0);
+  ASSERT_LT(3 * with.gradient_pixels, params.target_points);
+  EXPECT_TRUE(with.canny_used);
+  // Perimeter 2 * (120 + 90 + 150 + 100 + 60 + 60) = 1160 px: about one pixel per 8 px of edge.
+  EXPECT_GT(with.canny_pixels, 100);
+  EXPECT_EQ(with.gradient_pixels, without.gradient_pixels);
+  EXPECT_EQ(static_cast<int>(with.pixels.size()), with.gradient_pixels + with.canny_pixels);
+  EXPECT_TRUE(isRowMajor(with.pixels));
+
+  const std::set<std::pair<int, int>> gradient([&] {
+    std::set<std::pair<int, int>> s;
+    for (const cv::Point& p : without.pixels) s.insert({p.x, p.y});
+    return s;
+  }());
+  int added = 0;
+  for (const cv::Point& p : with.pixels) {
+    if (gradient.count({p.x, p.y})) continue;
+    ++added;
+    EXPECT_TRUE(nearRectangleEdge(p)) << "Canny pixel off the edges at " << p;
+  }
+  EXPECT_EQ(added, with.canny_pixels);
+  // At most one added pixel per 8x8 block.
+  std::set<std::pair<int, int>> blocks;
+  for (const cv::Point& p : with.pixels) {
+    if (!gradient.count({p.x, p.y})) {
+      EXPECT_TRUE(blocks.insert({p.x / 8, p.y / 8}).second) << "two Canny pixels in block of " << p;
+    }
+  }
+}
+
+TEST(PointSelector, OddSizedViewGivesTheSameAsItsCopy) {
+  // A view into a larger image is not continuous in memory; odd sizes leave partial blocks and
+  // pyramid levels that drop a column.
+  const cv::Mat big = texturedImage(640, 480, 13);
+  const cv::Mat view = big(cv::Rect(17, 9, 333, 251));
+  ASSERT_FALSE(view.isContinuous());
+  const cv::Mat depth = constantDepth(view.size(), 2.f);
+  SelectionParams params;
+  params.target_points = 1000;
+  const Selection a = selectPixels(view, depth, params);
+  const Selection b = selectPixels(view.clone(), depth, params);
+  EXPECT_EQ(a.pixels, b.pixels);
+  EXPECT_NEAR(static_cast<double>(a.pixels.size()), 1000, 50);
+  for (const cv::Point& p : a.pixels) {
+    ASSERT_TRUE(p.x >= 4 && p.y >= 4 && p.x < view.cols - 4 && p.y < view.rows - 4) << p;
+  }
+}
+
+TEST(PointSelector, BlankImageSelectsNothing) {
+  const cv::Mat gray(120, 160, CV_8UC1, cv::Scalar(128));
+  const Selection s = selectPixels(gray, constantDepth(gray.size(), 2.f), SelectionParams());
+  EXPECT_TRUE(s.pixels.empty());
+  EXPECT_EQ(s.gradient_pixels, 0);
+  EXPECT_TRUE(s.canny_used);
+  EXPECT_EQ(s.canny_pixels, 0);
+}
+
+TEST(PointSelector, KitchenFramesCountNearTarget) {
+  const auto data = test::sharedDataDir();
+  if (data.empty()) GTEST_SKIP() << "shared data (../shared/data) is absent";
+  const auto dir = data / "kitchen7s_dev";
+  std::ifstream assoc(dir / "associations.txt");
+  ASSERT_TRUE(assoc) << "no associations.txt in " << dir;
+  std::string line;
+  int frames = 0;
+  double sum_before = 0, sum_after = 0;
+  int min_after = std::numeric_limits<int>::max(), max_after = 0;
+  while (std::getline(assoc, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream fields(line);
+    std::string t_rgb, rgb, t_depth, depth_file;
+    fields >> t_rgb >> rgb >> t_depth >> depth_file;
+    const cv::Mat gray = cv::imread((dir / rgb).string(), cv::IMREAD_GRAYSCALE);
+    const cv::Mat raw = cv::imread((dir / depth_file).string(), cv::IMREAD_UNCHANGED);
+    ASSERT_FALSE(gray.empty() || raw.empty()) << line;
+    const Selection s = selectPixels(gray, depthToMeters(raw, 5000.0), SelectionParams());
+    const int before = s.gradient_pixels + s.canny_pixels;
+    const int after = static_cast<int>(s.pixels.size());
+    EXPECT_NEAR(before, 3000, 150) << rgb;
+    EXPECT_GT(after, 0.75 * before) << rgb;
+    sum_before += before;
+    sum_after += after;
+    min_after = std::min(min_after, after);
+    max_after = std::max(max_after, after);
+    ++frames;
+  }
+  ASSERT_EQ(frames, 50);
+  std::cout << "kitchen7s_dev: mean " << sum_before / frames << " selected, mean "
+            << sum_after / frames << " with valid depth (min " << min_after << ", max " << max_after
+            << ")\n";
+}
+
+}  // namespace
+}  // namespace acvo
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  return RUN_ALL_TESTS();
+}
