@@ -27,8 +27,8 @@ Covariance6 sanitise(const Covariance6& c) {
 }
 
 Covariance6 accumulate(const Covariance6& pose, const Covariance6& relative,
-                       const Eigen::Matrix3d& odom_from_camk) {
-  return pose + rotate(sanitise(relative), odom_from_camk);
+                       const Eigen::Matrix3d& odom_from_frame) {
+  return pose + rotate(sanitise(relative), odom_from_frame);
 }
 
 std::array<double, 36> toArray(const Covariance6& c) {

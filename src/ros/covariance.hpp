@@ -1,13 +1,14 @@
 // The covariance model of the published odometry (documented in docs/ros.md).
 //
 // The engine gives, per frame, the covariance of the relative motion (left perturbation,
-// rotation first, in the current camera frame). The published pose covariance is the sum of
-// these relative covariances, each rotated into the odometry frame's axes by the camera's
-// orientation at that frame: a random walk that ignores the correlation between rotation error
-// and later translation (the lever arm), so it grows linearly with the number of frames. The
-// twist covariance is the relative covariance divided by dt^2. A lost frame adds kLostVariance
-// to every diagonal entry of the pose covariance (its motion is unknown, so is every pose after
-// it until a reset), and its twist gets kLostVariance alone.
+// rotation first, expressed in the previous camera's frame; a scaled inverse of the objective's
+// curvature at the optimum, inflated when tracking is hard). The published pose covariance is
+// the sum of these relative covariances, each rotated into the odometry frame's axes by the
+// previous camera's orientation: a random walk that ignores the correlation between rotation
+// error and later translation (the lever arm), so it grows linearly with the number of frames.
+// The twist covariance is the relative covariance divided by dt^2. A lost frame adds
+// kLostVariance to every diagonal entry of the pose covariance (its motion is unknown, so is
+// every pose after it until a reset), and its twist gets kLostVariance alone.
 #pragma once
 
 #include <array>
@@ -40,10 +41,10 @@ Covariance6 rotate(const Covariance6& c, const Eigen::Matrix3d& a_from_b);
 Covariance6 sanitise(const Covariance6& c);
 
 // One step of the model: pose covariance after a frame whose relative-motion covariance is
-// `relative` (ROS order, camera frame k) and whose camera orientation in the odometry frame is
-// `odom_from_camk`.
+// `relative` (ROS order, in the frame the motion starts from), that frame's orientation in the
+// odometry frame being `odom_from_frame`.
 Covariance6 accumulate(const Covariance6& pose, const Covariance6& relative,
-                       const Eigen::Matrix3d& odom_from_camk);
+                       const Eigen::Matrix3d& odom_from_frame);
 
 // Row-major copy for the 36-element arrays of geometry_msgs.
 std::array<double, 36> toArray(const Covariance6& c);

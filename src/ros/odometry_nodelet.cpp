@@ -291,8 +291,10 @@ void OdometryNodelet::processFrame(const Image& rgb, const Image& depth, const I
                           "from this frame (%u lost so far)",
                           r.message.c_str(), lost_count_);
   } else if (r.tracking != acvo::Tracking::kFirstFrame) {
+    // The relative covariance is expressed in the previous camera's frame.
+    const Eigen::Matrix3d odom_from_previous = (r.pose * r.motion.inverse()).rotation();
     pose_covariance_ =
-        accumulate(pose_covariance_, toRosOrder(r.motion_covariance), r.pose.rotation());
+        accumulate(pose_covariance_, toRosOrder(r.motion_covariance), odom_from_previous);
   }
   publish(r, header, dt);
   publishInfo(r, header, msSince(start));

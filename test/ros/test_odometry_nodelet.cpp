@@ -204,13 +204,15 @@ class Client {
     if (!last_diag_ || last_diag_wall_ < after) return std::nullopt;
     return last_diag_;
   }
+  // Waits for an odometry diagnostic with this level and message; returns the last one seen.
   std::optional<diagnostic_msgs::DiagnosticStatus> waitDiagnostic(std::uint8_t level,
+                                                                  const std::string& message,
                                                                   double timeout = 5.0) {
     const ros::WallTime start = ros::WallTime::now();
     std::optional<diagnostic_msgs::DiagnosticStatus> d;
     while ((ros::WallTime::now() - start).toSec() < timeout) {
       d = diagnosticAfter(start);
-      if (d && d->level == level) return d;
+      if (d && d->level == level && d->message == message) return d;
       ros::WallDuration(0.05).sleep();
     }
     return d;
@@ -347,7 +349,7 @@ TEST(OdometryNodelet, TracksKnownMotionWithRightFramesCovarianceAndTf) {
   const Eigen::Isometry3d tf_pose = tf2::transformToEigen(*tf);
   EXPECT_TRUE(tf_pose.isApprox(toEigen(out.back().odom->pose.pose), 1e-6));
 
-  const auto diag = client->waitDiagnostic(diagnostic_msgs::DiagnosticStatus::OK);
+  const auto diag = client->waitDiagnostic(diagnostic_msgs::DiagnosticStatus::OK, "tracking");
   ASSERT_TRUE(diag);
   EXPECT_EQ(diag->level, diagnostic_msgs::DiagnosticStatus::OK) << diag->message;
   EXPECT_EQ(diag->message, "tracking");
@@ -445,7 +447,7 @@ TEST(OdometryNodelet, InvalidFramesAreLostThenTrackingResumes) {
     expectPoseNear(o->odom->pose.pose, toEigen(held), "held pose while lost");
   }
   EXPECT_EQ(flat.info->lost_count, lost_before + 2);
-  const auto diag = client->waitDiagnostic(diagnostic_msgs::DiagnosticStatus::ERROR);
+  const auto diag = client->waitDiagnostic(diagnostic_msgs::DiagnosticStatus::ERROR, "lost");
   ASSERT_TRUE(diag);
   EXPECT_EQ(diag->level, diagnostic_msgs::DiagnosticStatus::ERROR);
   EXPECT_EQ(diag->message, "lost");
@@ -461,7 +463,7 @@ TEST(OdometryNodelet, InvalidFramesAreLostThenTrackingResumes) {
       toEigen(again[0].odom->pose.pose).inverse() * toEigen(again.back().odom->pose.pose);
   const Eigen::Isometry3d want = client->expectedBase(cameraPose(5).inverse() * cameraPose(8));
   EXPECT_LT((since.translation() - want.translation()).norm(), kTranslationTolerance);
-  const auto ok = client->waitDiagnostic(diagnostic_msgs::DiagnosticStatus::OK);
+  const auto ok = client->waitDiagnostic(diagnostic_msgs::DiagnosticStatus::OK, "tracking");
   ASSERT_TRUE(ok);
   EXPECT_EQ(ok->message, "tracking");
 }
@@ -536,8 +538,8 @@ TEST(OdometryNodelet, StampsRepeatedAreDroppedAndAJumpBackRestarts) {
 }
 
 TEST(OdometryNodelet, NoDataIsAnError) {
-  ros::WallDuration(1.5).sleep();  // no_data_timeout is 1 s in the .test files
-  const auto diag = client->waitDiagnostic(diagnostic_msgs::DiagnosticStatus::ERROR);
+  // no_data_timeout is 3 s in test_params.yaml.
+  const auto diag = client->waitDiagnostic(diagnostic_msgs::DiagnosticStatus::ERROR, "no data", 8.0);
   ASSERT_TRUE(diag);
   EXPECT_EQ(diag->message, "no data");
 }
