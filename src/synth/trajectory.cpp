@@ -10,10 +10,10 @@ namespace acvo::synth {
 namespace {
 
 constexpr double kReferenceSpeed = 0.3;      // m/s at which the random waves' base frequencies apply
-// Worst-case bounds (all waves of an axis at their peaks together) on the random motion's
-// offset from the start, per axis; actual offsets stay well inside.
-constexpr double kMaxRandomOffset = 0.8;  // m
-constexpr double kMaxRandomAngle = 0.7;   // rad (40 deg)
+// Bounds on the random motion's offsets from the start over a sequence, per axis of the
+// start's camera frame (translation) and per rotation-vector component.
+constexpr double kMaxRandomOffset = 0.5;  // m
+constexpr double kMaxRandomAngle = 0.5;   // rad (29 deg)
 constexpr double kXyzAmplitude = 0.2;        // m
 constexpr double kRpyAmplitude = 15.0 * M_PI / 180.0;
 constexpr double kCircleRadius = 0.5;        // m
@@ -70,8 +70,9 @@ Motion::Motion(const MotionOptions& options) : options_(options) {
     throw std::invalid_argument("speed must be a non-negative number");
   if (options.kind != MotionKind::kRandom) return;
 
-  // Faster motion oscillates faster rather than wider, so the camera stays in the room.
-  const double time_scale = std::max(options.speed, 0.05) / kReferenceSpeed;
+  // Faster motion oscillates faster rather than wider, so the camera stays in the room;
+  // slower motion keeps the reference frequencies with smaller amplitudes.
+  const double time_scale = std::max(options.speed, kReferenceSpeed) / kReferenceSpeed;
   Rng rng(hashCombine(options.seed, 17));
   const double translation_weight[3] = {1.0, 0.5, 0.7};  // right, down, forward
   const double rotation_weight[3] = {0.6, 1.0, 0.35};    // tilt, pan, roll
@@ -86,45 +87,41 @@ Motion::Motion(const MotionOptions& options) : options_(options) {
     }
   }
 
-  // Gains that give the requested mean speeds over the sequence, measured on a fine grid.
-  const double duration = options.frames > 1 ? (options.frames - 1) / options.rate : 0.0;
-  const int steps = std::max(1, 8 * (options.frames - 1));
-  const double dt = duration / steps;
-  auto bound = [](const std::vector<Wave> (&waves)[3]) {
-    double worst = 0.0;
-    for (const auto& axis : waves) {
-      double sum = 0.0;
-      for (const Wave& w : axis) sum += 2.0 * std::abs(w.amplitude);
-      worst = std::max(worst, sum);
-    }
-    return worst;
-  };
-  translation_gain_ = 1.0;
-  rotation_gain_ = 1.0;
-  if (duration <= 0.0 || options.speed == 0.0) {
-    translation_gain_ = rotation_gain_ = options.speed == 0.0 ? 0.0 : 1.0;
-  } else {
-    double path = 0.0;
-    for (int i = 0; i < steps; ++i)
-      path += (sumWaves(translation_waves_, (i + 1) * dt) - sumWaves(translation_waves_, i * dt))
-                  .norm();
-    translation_gain_ = options.speed * duration / path;
-    // The angle of exp(g r(t)) is not exactly linear in g: a few fixed-point rounds settle it.
-    const double target = options.speed * kAngularPerLinear * duration;
-    for (int round = 0; round < 4; ++round) {
-      double angle = 0.0;
-      Eigen::Matrix3d previous = expSo3(rotation_gain_ * sumWaves(rotation_waves_, 0.0));
-      for (int i = 1; i <= steps; ++i) {
-        const Eigen::Matrix3d current = expSo3(rotation_gain_ * sumWaves(rotation_waves_, i * dt));
-        angle += rotationAngle(previous, current);
-        previous = current;
-      }
-      if (angle <= 0.0) break;
-      rotation_gain_ *= target / angle;
-    }
+  if (options.speed == 0.0) {
+    translation_gain_ = rotation_gain_ = 0.0;
+    return;
   }
-  translation_gain_ = std::min(translation_gain_, kMaxRandomOffset / bound(translation_waves_));
-  rotation_gain_ = std::min(rotation_gain_, kMaxRandomAngle / bound(rotation_waves_));
+  // Gains that give the requested mean speeds over the sequence (at least one frame
+  // interval), measured on a fine grid.
+  const int intervals = std::max(options.frames - 1, 1);
+  const int steps = 8 * intervals;
+  const double duration = intervals / options.rate, dt = duration / steps;
+  double path = 0.0;
+  for (int i = 0; i < steps; ++i)
+    path += (sumWaves(translation_waves_, (i + 1) * dt) - sumWaves(translation_waves_, i * dt))
+                .norm();
+  translation_gain_ = options.speed * duration / path;
+  // The angle of exp(g r(t)) is not exactly linear in g: a few fixed-point rounds settle it.
+  const double target_angle = options.speed * kAngularPerLinear * duration;
+  for (int round = 0; round < 4; ++round) {
+    double angle = 0.0;
+    Eigen::Matrix3d previous = Eigen::Matrix3d::Identity();  // r(0) = 0
+    for (int i = 1; i <= steps; ++i) {
+      const Eigen::Matrix3d current = expSo3(rotation_gain_ * sumWaves(rotation_waves_, i * dt));
+      angle += rotationAngle(previous, current);
+      previous = current;
+    }
+    rotation_gain_ *= target_angle / angle;
+  }
+  // Rarely (unlucky phases, long sequences) the offsets from the start would grow too large:
+  // then the motion is scaled down, slower than asked but still in the room.
+  double offset = 0.0, angle = 0.0;
+  for (int i = 0; i <= steps; ++i) {
+    offset = std::max(offset, sumWaves(translation_waves_, i * dt).cwiseAbs().maxCoeff());
+    angle = std::max(angle, sumWaves(rotation_waves_, i * dt).cwiseAbs().maxCoeff());
+  }
+  translation_gain_ = std::min(translation_gain_, kMaxRandomOffset / offset);
+  rotation_gain_ = std::min(rotation_gain_, kMaxRandomAngle / angle);
 }
 
 Eigen::Vector3d Motion::sumWaves(const std::vector<Wave> (&waves)[3], double t) {

@@ -5,11 +5,14 @@
 // inside the room and keeps looking into the furnished part (or at the single plane when the
 // scene has no structure), at any length of sequence.
 //
-//   random  sums of three low-frequency sinusoids per translation axis and per rotation axis
-//           (camera frame), seeded frequencies and phases; scaled so that the mean linear speed
-//           over the sequence is `speed` and the mean angular speed is
-//           speed * kAngularPerLinear (0.3 m/s -> 24 deg/s), handheld-like. Amplitudes stay
-//           below about 0.6 m and 25 deg.
+//   random  sums of three sinusoids (0.15-0.7 Hz at 0.3 m/s, faster for faster motion) per
+//           translation axis and per rotation axis of the start's camera frame, seeded
+//           frequencies, amplitudes and phases; scaled so that the mean linear speed over the
+//           sequence is `speed` and the mean angular speed speed * kAngularPerLinear
+//           (0.3 m/s -> 24 deg/s), handheld-like. Offsets from the start stay within 0.5 m
+//           per axis and 0.5 rad per rotation-vector component (typically about 0.35 m and
+//           25 deg); in the rare sequence that would exceed them, the motion is scaled down
+//           and is slower than asked.
 //   xyz     back and forth along the camera's x, y, z axes in turn (+-0.2 m), speed `speed`.
 //   rpy     rotation back and forth about the camera's x, y, z axes in turn (+-15 deg) at
 //           speed * kAngularPerLinear, the optical centre fixed.
