@@ -1,0 +1,157 @@
+#include "acvo/odometry.hpp"
+
+#include <chrono>
+#include <cmath>
+
+#include <Eigen/Eigenvalues>
+#include <tbb/task_arena.h>
+
+#include "acvo/se3.hpp"
+
+namespace acvo {
+
+struct Odometry::Arena {
+  explicit Arena(int threads)
+      : arena(threads > 0 ? threads : tbb::task_arena::automatic) {}
+  tbb::task_arena arena;
+};
+
+std::string toString(Tracking t) {
+  switch (t) {
+    case Tracking::kOk: return "ok";
+    case Tracking::kHard: return "hard";
+    case Tracking::kLost: return "lost";
+    case Tracking::kFirstFrame: return "first_frame";
+    case Tracking::kBadFrame: return "bad_frame";
+  }
+  return "unknown";
+}
+
+Odometry::Odometry(const Params& params)
+    : params_(params), arena_(std::make_unique<Arena>(params.odometry.threads)) {}
+Odometry::~Odometry() = default;
+Odometry::Odometry(Odometry&&) noexcept = default;
+Odometry& Odometry::operator=(Odometry&&) noexcept = default;
+
+void Odometry::reset(const Eigen::Isometry3d& pose) {
+  pose_ = pose;
+  velocity_ = Eigen::Isometry3d::Identity();
+  reference_.reset();
+}
+
+const LabelledCloud* Odometry::lastCloud() const {
+  return reference_ ? &reference_->cloud : nullptr;
+}
+
+OdometryResult Odometry::process(const Frame& frame) {
+  using Clock = std::chrono::steady_clock;
+  OdometryResult r;
+  r.pose = pose_;
+  if (std::string why = frame.problem(); !why.empty()) {
+    r.tracking = Tracking::kBadFrame;
+    r.message = why;
+    r.motion_covariance = Eigen::Matrix<double, 6, 6>::Identity() * 1e6;
+    return r;
+  }
+
+  const auto t0 = Clock::now();
+  std::optional<PreparedCloud> current;
+  arena_->arena.execute([&] {
+    current = prepareCloud(buildLabelledCloud(frame, params_.selection, &r.cloud_stats),
+                           params_.solver);
+  });
+  r.ms_cloud = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+  r.moving_points = current->size();
+
+  if (!reference_) {
+    reference_ = std::move(current);
+    r.tracking = Tracking::kFirstFrame;
+    r.fixed_points = 0;
+    return r;
+  }
+  r.fixed_points = reference_->size();
+
+  const Eigen::Isometry3d guess = params_.odometry.initial_guess == InitialGuess::kConstantVelocity
+                                      ? velocity_
+                                      : Eigen::Isometry3d::Identity();
+  arena_->arena.execute([&] { r.solver = align(*reference_, *current, guess, params_.solver); });
+  r.ms_registration = r.solver.ms_total;
+
+  // Judge the result.
+  const auto& op = params_.odometry;
+  const SolverResult& s = r.solver;
+  const Vector6d xi = logSE3(s.transform);
+  const double rotation_deg = xi.head<3>().norm() * 180.0 / M_PI;
+  const double translation = s.transform.translation().norm();
+  const bool too_few = s.status == SolverStatus::kTooFewPoints;
+  if (too_few || s.status == SolverStatus::kNotFinite) {
+    r.tracking = Tracking::kLost;
+    r.message = "registration failed: " + toString(s.status) + " (" +
+                std::to_string(r.fixed_points) + " and " + std::to_string(r.moving_points) +
+                " points)";
+  } else if (s.inner_product < op.lost_inner_product) {
+    r.tracking = Tracking::kLost;
+    r.message = "clouds do not overlap (normalised inner product " +
+                std::to_string(s.inner_product) + ")";
+  } else if (translation > op.max_translation || rotation_deg > op.max_rotation) {
+    r.tracking = Tracking::kLost;
+    r.message = "implausible motion (" + std::to_string(translation) + " m, " +
+                std::to_string(rotation_deg) + " deg in one frame)";
+  } else if (s.inner_product < op.hard_inner_product) {
+    r.tracking = Tracking::kHard;
+    r.message = "weak overlap (normalised inner product " + std::to_string(s.inner_product) + ")";
+  } else if (s.status == SolverStatus::kMaxIterations) {
+    r.tracking = Tracking::kHard;
+    r.message = "iteration cap reached";
+  } else if (s.ell_at_bound) {
+    r.tracking = Tracking::kHard;
+    r.message = "length-scale pinned at a bound";
+  } else {
+    r.tracking = Tracking::kOk;
+  }
+
+  if (r.tracking == Tracking::kLost) {
+    // Keep the last good pose; never extrapolate a motion we could not confirm.
+    velocity_ = Eigen::Isometry3d::Identity();
+    r.motion = Eigen::Isometry3d::Identity();
+    r.motion_covariance = Eigen::Matrix<double, 6, 6>::Identity() * 1e6;
+    if (!too_few || int(current->size()) >= params_.solver.min_points) {
+      reference_ = std::move(current);
+    }
+    r.pose = pose_;
+    return r;
+  }
+
+  r.motion = s.transform;
+  velocity_ = s.transform;
+  pose_ = normalized(pose_ * s.transform);
+  r.pose = pose_;
+  reference_ = std::move(current);
+
+  // Covariance from the curvature of the objective (negative definite at a maximum).
+  const Eigen::Matrix<double, 6, 6> info = -s.hessian;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eig(0.5 * (info + info.transpose()));
+  Eigen::Matrix<double, 6, 1> lambda = eig.eigenvalues();
+  const double floor = 1e-12 * std::max(lambda.maxCoeff(), 1e-300);
+  bool degenerate = false;
+  for (int k = 0; k < 6; ++k) {
+    if (!(lambda[k] > floor)) {
+      lambda[k] = floor;
+      degenerate = true;
+    }
+  }
+  Eigen::Matrix<double, 6, 6> cov = eig.eigenvectors() * lambda.cwiseInverse().asDiagonal() *
+                                    eig.eigenvectors().transpose() * op.covariance_scale;
+  if (degenerate || !cov.allFinite()) {
+    cov = Eigen::Matrix<double, 6, 6>::Identity() * 1e6;
+    if (r.tracking == Tracking::kOk) {
+      r.tracking = Tracking::kHard;
+      r.message = "motion not constrained in every direction";
+    }
+  }
+  if (r.tracking == Tracking::kHard) cov *= 10.0;
+  r.motion_covariance = cov;
+  return r;
+}
+
+}  // namespace acvo

@@ -1,0 +1,171 @@
+#include "synth/sequence.hpp"
+
+#include <atomic>
+#include <cmath>
+#include <filesystem>
+#include <mutex>
+#include <sstream>
+#include <stdexcept>
+
+#include <opencv2/imgcodecs.hpp>
+#include <tbb/parallel_for.h>
+
+#include "synth/random.hpp"
+#include "synth/tum_writer.hpp"
+
+namespace acvo::synth {
+namespace {
+
+const SequenceOptions& validated(const SequenceOptions& o) {
+  if (o.frames < 0) throw std::invalid_argument("frames must not be negative");
+  if (!(o.rate > 0) || !std::isfinite(o.rate)) throw std::invalid_argument("rate must be positive");
+  if (!(o.speed >= 0) || !std::isfinite(o.speed))
+    throw std::invalid_argument("speed must be a non-negative number");
+  if (!o.camera.valid()) throw std::invalid_argument("invalid camera");
+  if (o.blur_samples < 1) throw std::invalid_argument("blur_samples must be at least 1");
+  if (!(o.exposure >= 0 && o.exposure <= 1))
+    throw std::invalid_argument("exposure must be within [0, 1]");
+  return o;
+}
+
+std::string describe(const SequenceOptions& o) {
+  std::ostringstream s;
+  s << "synthetic sequence (acvo_synth): motion " << toString(o.motion) << ", speed " << o.speed
+    << " m/s, rate " << o.rate << " Hz, seed " << o.seed << ", structure "
+    << (o.structure ? "on" : "off") << ", texture " << (o.texture ? "on" : "off") << ", noise "
+    << (o.noise ? "on" : "off") << ", blur " << (o.blur ? "on" : "off") << ", "
+    << o.camera.width << "x" << o.camera.height;
+  return s.str();
+}
+
+void writeImage(const std::string& path, const cv::Mat& image) {
+  bool ok = false;
+  try {
+    ok = cv::imwrite(path, image);
+  } catch (const cv::Exception& e) {
+    throw std::runtime_error("cannot write " + path + ": " + e.what());
+  }
+  if (!ok) throw std::runtime_error("cannot write " + path);
+}
+
+}  // namespace
+
+MotionOptions SequenceOptions::motionOptions() const {
+  MotionOptions m;
+  m.kind = motion;
+  m.frames = frames;
+  m.rate = rate;
+  m.speed = speed;
+  m.seed = seed;
+  return m;
+}
+
+RenderOptions SequenceOptions::renderOptions() const {
+  RenderOptions r;
+  r.camera = camera;
+  r.noise = noise;
+  return r;
+}
+
+Camera scaledDefaultCamera(int width, int height) {
+  Camera c;  // 640x480 defaults
+  const double sx = width / 640.0, sy = height / 480.0;
+  c.fx *= sx;
+  c.fy *= sy;
+  // Scale the distance from the image corner (-0.5, -0.5), not from pixel (0, 0).
+  c.cx = (c.cx + 0.5) * sx - 0.5;
+  c.cy = (c.cy + 0.5) * sy - 0.5;
+  c.width = width;
+  c.height = height;
+  return c;
+}
+
+SynthSequence::SynthSequence(const SequenceOptions& options)
+    : options_(validated(options)),
+      scene_(makeScene(options.sceneOptions())),
+      motion_(options.motionOptions()) {
+  poses_.reserve(options_.frames);
+  for (int i = 0; i < options_.frames; ++i) poses_.push_back(motion_.poseAt(i / options_.rate));
+}
+
+SynthFrame SynthSequence::frame(int i) const {
+  if (i < 0 || i >= size()) throw std::out_of_range("synthetic frame index out of range");
+  const std::uint64_t noise_seed = hashCombine(hashCombine(options_.seed, 3), i);
+  const RenderOptions render_options = options_.renderOptions();
+  SynthFrame f;
+  if (options_.blur && options_.blur_samples > 1 && options_.exposure > 0) {
+    // Sub-frame poses spread evenly over the shutter time, centred on the frame's time.
+    std::vector<Eigen::Isometry3d> exposure;
+    const double t = i / options_.rate, shutter = options_.exposure / options_.rate;
+    for (int k = 0; k < options_.blur_samples; ++k)
+      exposure.push_back(
+          motion_.poseAt(t + shutter * (k / (options_.blur_samples - 1.0) - 0.5)));
+    f = renderBlurred(scene_, poses_[i], exposure, render_options, noise_seed);
+  } else {
+    f = render(scene_, poses_[i], render_options, noise_seed);
+  }
+  f.stamp = stamp(i);
+  return f;
+}
+
+cv::Mat depthToPng16(const cv::Mat& depth_m, double depth_scale) {
+  CV_Assert(depth_m.type() == CV_32FC1);
+  cv::Mat out(depth_m.size(), CV_16UC1);
+  for (int v = 0; v < depth_m.rows; ++v) {
+    const float* in = depth_m.ptr<float>(v);
+    auto* o = out.ptr<std::uint16_t>(v);
+    for (int u = 0; u < depth_m.cols; ++u) {
+      const double raw = std::round(static_cast<double>(in[u]) * depth_scale);
+      o[u] = raw > 0 && raw <= 65535 ? static_cast<std::uint16_t>(raw) : 0;
+    }
+  }
+  return out;
+}
+
+void writeSequence(const std::string& folder, const SequenceOptions& options,
+                   const std::function<void(int done, int total)>& progress) {
+  const SynthSequence sequence(options);
+  namespace fs = std::filesystem;
+  std::error_code error;
+  for (const char* sub : {"rgb", "depth"}) {
+    fs::create_directories(fs::path(folder) / sub, error);
+    if (error) throw std::runtime_error("cannot create " + folder + "/" + sub + ": " + error.message());
+  }
+
+  const int n = sequence.size();
+  std::vector<StampedFile> rgb(n), depth(n);
+  std::vector<std::string> stamps(n);
+  for (int i = 0; i < n; ++i) {
+    stamps[i] = formatStamp(sequence.stamp(i));
+    rgb[i] = {stamps[i], "rgb/" + stamps[i] + ".png"};
+    depth[i] = {stamps[i], "depth/" + stamps[i] + ".png"};
+  }
+
+  std::atomic<int> done{0};
+  std::mutex progress_mutex;
+  // One frame per task: frames are independent, and each renders its rows in parallel too.
+  tbb::parallel_for(0, n, [&](int i) {
+    const SynthFrame f = sequence.frame(i);
+    writeImage((fs::path(folder) / rgb[i].path).string(), f.bgr);
+    writeImage((fs::path(folder) / depth[i].path).string(),
+               depthToPng16(f.depth_m, options.camera.depth_scale));
+    const int finished = ++done;
+    if (progress) {
+      const std::lock_guard<std::mutex> lock(progress_mutex);
+      progress(finished, n);
+    }
+  });
+
+  const std::string about = describe(options);
+  const fs::path root(folder);
+  writeFileList((root / "rgb.txt").string(), "color images\n" + about, rgb);
+  writeFileList((root / "depth.txt").string(), "depth maps\n" + about, depth);
+  writeAssociations((root / "associations.txt").string(), about, rgb, depth);
+  writeGroundtruth((root / "groundtruth.txt").string(),
+                   "ground truth trajectory: camera-to-world, optical frame (x right, y down, "
+                   "z forward)\n" + about,
+                   stamps, sequence.poses());
+  saveCameraYaml((root / "camera.yaml").string(), options.camera);
+}
+
+}  // namespace acvo::synth

@@ -1,0 +1,86 @@
+// Synthetic RGB-D sequences: a scene, a trajectory and a renderer put together, in memory
+// (frame by frame) or written as a TUM-format folder.
+//
+// Typical use in a test of another module:
+//
+//   acvo::synth::SequenceOptions o;
+//   o.frames = 2; o.noise = false;
+//   acvo::synth::SynthSequence seq(o);
+//   auto a = seq.frame(0), b = seq.frame(1);
+//   Eigen::Isometry3d b_to_a = a.pose.inverse() * b.pose;   // exact relative motion:
+//   // maps points of frame b's optical frame into frame a's.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "synth/renderer.hpp"
+#include "synth/scene.hpp"
+#include "synth/trajectory.hpp"
+
+namespace acvo::synth {
+
+// Everything acvo_synth's options say; the defaults are the tool's.
+struct SequenceOptions {
+  int frames = 300;
+  double rate = 30.0;  // Hz
+  MotionKind motion = MotionKind::kRandom;
+  double speed = 0.3;      // m/s
+  std::uint64_t seed = 1;  // scene, trajectory and noise
+  bool structure = true;
+  bool texture = true;
+  bool noise = true;
+  bool blur = false;
+  int blur_samples = 5;       // sub-frame renders averaged per blurred frame
+  double exposure = 0.5;      // shutter time as a fraction of the frame interval (blur)
+  Camera camera;              // TUM default intrinsics, 640x480, depth scale 5000
+  double first_stamp = 1000.0;  // seconds; frame i is at first_stamp + i / rate
+
+  SceneOptions sceneOptions() const { return {structure, texture, seed}; }
+  MotionOptions motionOptions() const;
+  RenderOptions renderOptions() const;
+};
+
+// The camera scaled to width x height from the TUM default 640x480 intrinsics (focal lengths
+// in proportion, principal point at the same place relative to the pixel centres).
+Camera scaledDefaultCamera(int width, int height);
+
+class SynthSequence {
+ public:
+  // Throws std::invalid_argument for bad options (frames < 0, rate <= 0, speed < 0,
+  // invalid camera, blur_samples < 1, exposure outside [0, 1]).
+  explicit SynthSequence(const SequenceOptions& options);
+
+  int size() const { return options_.frames; }
+  double stamp(int i) const { return options_.first_stamp + i / options_.rate; }
+  const std::vector<Eigen::Isometry3d>& poses() const { return poses_; }  // camera-to-world
+  const Scene& scene() const { return scene_; }
+  const Motion& motion() const { return motion_; }
+  const SequenceOptions& options() const { return options_; }
+
+  // Frame i (0 <= i < size()), stamp and pose set. Any order, from any thread; the same i
+  // always gives the same images.
+  SynthFrame frame(int i) const;
+
+ private:
+  SequenceOptions options_;
+  Scene scene_;
+  Motion motion_;
+  std::vector<Eigen::Isometry3d> poses_;
+};
+
+// Writes a TUM-format folder: rgb/<stamp>.png (8-bit colour), depth/<stamp>.png (16-bit,
+// camera.depth_scale units per metre, 0 = invalid), rgb.txt, depth.txt, associations.txt
+// (depth stamps equal rgb stamps), groundtruth.txt (camera-to-world) and camera.yaml.
+// Frames are rendered in parallel; `progress(done, total)` is called after each frame, one
+// call at a time. Throws std::runtime_error when something cannot be written.
+void writeSequence(const std::string& folder, const SequenceOptions& options,
+                   const std::function<void(int done, int total)>& progress = {});
+
+// Depth in metres (CV_32FC1, 0 invalid) as a TUM 16-bit PNG image: round(z * depth_scale),
+// 0 where invalid or beyond the 16-bit range.
+cv::Mat depthToPng16(const cv::Mat& depth_m, double depth_scale);
+
+}  // namespace acvo::synth
