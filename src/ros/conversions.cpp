@@ -141,13 +141,14 @@ CameraResult cameraFor(const sensor_msgs::CameraInfo& info, int width, int heigh
   } else if (override_intrinsics.named()) {
     cam = acvo::cameraByName(override_intrinsics.camera);
     // Named intrinsics are for 640x480; a driver streaming another resolution of the same
-    // sensor scales them.
+    // sensor scales them (the principal point about the image corner, pixel centres being
+    // at integer coordinates).
     const double sx = static_cast<double>(width) / cam.width;
     const double sy = static_cast<double>(height) / cam.height;
     cam.fx *= sx;
-    cam.cx *= sx;
     cam.fy *= sy;
-    cam.cy *= sy;
+    cam.cx = (cam.cx + 0.5) * sx - 0.5;
+    cam.cy = (cam.cy + 0.5) * sy - 0.5;
   } else {
     const auto& K = info.K;
     if (!(K[0] > 0.0 && K[4] > 0.0 && std::isfinite(K[0]) && std::isfinite(K[4]) &&

@@ -147,7 +147,7 @@ TEST(CameraFor, OverridesWinOverCameraInfo) {
   EXPECT_DOUBLE_EQ(fr1.camera.cy, 255.3);
   const CameraResult half = cameraFor(zero, 320, 240, named);
   EXPECT_DOUBLE_EQ(half.camera.fx, 517.3 / 2);
-  EXPECT_DOUBLE_EQ(half.camera.cy, 255.3 / 2);
+  EXPECT_DOUBLE_EQ(half.camera.cy, (255.3 + 0.5) / 2 - 0.5);
 
   IntrinsicsOverride values;
   values.fx = 400;
