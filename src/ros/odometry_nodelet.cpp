@@ -546,6 +546,8 @@ void OdometryNodelet::onReconfigure(acvo::AcvoConfig& config, uint32_t /*level*/
     const std::string invalid = acvo::validate(next);
     if (!invalid.empty()) {
       NODELET_ERROR("dynamic_reconfigure: %s: keeping the previous parameters", invalid.c_str());
+      // The server publishes what the callback leaves in `config`: show the values in use.
+      config = toConfig(params_, publish_null_when_lost_);
       return;
     }
     if (describeParams(next) == describeParams(params_)) return;
@@ -557,6 +559,7 @@ void OdometryNodelet::onReconfigure(acvo::AcvoConfig& config, uint32_t /*level*/
                  describeParams(params_).c_str());
   } catch (const std::exception& e) {
     NODELET_ERROR("dynamic_reconfigure: %s: keeping the previous parameters", e.what());
+    config = toConfig(params_, publish_null_when_lost_);
   }
 }
 
