@@ -405,6 +405,7 @@ std::optional<Eigen::Isometry3d> OdometryNodelet::baseFromCamera() {
   const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(wait_for_transform_);
   std::string error;
   while (true) {
+    error.clear();  // canTransform appends
     if (tf_buffer_->canTransform(base, camera_frame_, ros::Time(0), &error)) {
       base_from_camera_ =
           tf2::transformToEigen(tf_buffer_->lookupTransform(base, camera_frame_, ros::Time(0)));

@@ -5,7 +5,9 @@
 // from colour stamps), camera_frame (as sent, may carry a leading '/'), odom_frame and
 // base_frame (expected ids), base_from_camera ("x y z qx qy qz qw" of the static transform the
 // .test publishes; empty = base is the optical frame), exact_stamps (run the stamp tests, which
-// need exact synchronisation: the approximate policy itself swallows reordered stamps).
+// need exact synchronisation: the approximate policy itself swallows reordered stamps),
+// late_base_tf (the .test publishes no base transform; the test sends it itself, after checking
+// that nothing is published without it).
 #include <cmath>
 #include <map>
 #include <mutex>
@@ -20,6 +22,7 @@
 #include <sensor_msgs/PointCloud2.h>
 #include <std_srvs/Empty.h>
 #include <tf2_eigen/tf2_eigen.h>
+#include <tf2_ros/static_transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
 
 #include "acvo/OdometryInfo.h"
@@ -81,6 +84,7 @@ class Client {
     odom_frame_ = pnh_.param<std::string>("odom_frame", "odom");
     base_frame_ = pnh_.param<std::string>("base_frame", acvo_ros::stripSlash(camera_frame_));
     exact_stamps_ = pnh_.param("exact_stamps", false);
+    late_base_tf_ = pnh_.param("late_base_tf", false);
     base_from_camera_ = Eigen::Isometry3d::Identity();
     std::istringstream tf(pnh_.param<std::string>("base_from_camera", ""));
     double x, y, z, qx, qy, qz, qw;
@@ -251,6 +255,7 @@ class Client {
   ros::NodeHandle nh_, pnh_;
   std::string depth_encoding_, color_encoding_, camera_frame_, odom_frame_, base_frame_;
   bool approx_ = true, exact_stamps_ = false;
+  bool late_base_tf_ = false;  // the .test publishes no base transform: the test sends it
   Eigen::Isometry3d base_from_camera_;
   ros::Publisher rgb_pub_, depth_pub_, info_pub_;
   ros::Subscriber odom_sub_, info_sub_, diag_sub_;
@@ -614,6 +619,52 @@ TEST(OdometryNodelet, ReconfigureRestartsTrackingWithNewParametersAndRefusesBadO
   EXPECT_LT(refused[0].info->moving_points, 700u);
 
   reconfigure("target_points", 1500, true);
+}
+
+TEST(OdometryNodelet, LostFramesPublishNothingWhenAskedTo) {
+  if (client->late_base_tf_) GTEST_SKIP() << "covered by the other configurations";
+  ASSERT_TRUE(client->reset());
+  client->run(range(0, 3));
+  dynamic_reconfigure::Reconfigure srv;
+  dynamic_reconfigure::BoolParameter p;
+  p.name = "publish_null_when_lost";
+  p.value = true;
+  srv.request.config.bools.push_back(p);
+  ASSERT_TRUE(ros::service::call("acvo/set_parameters", srv));
+  const ros::Time t = client->nextStamp();
+  client->send(client->blank(), t);
+  client->flush();
+  const Outcome o = client->outcome(t, false);
+  ASSERT_TRUE(o.info);
+  EXPECT_TRUE(o.info->lost);
+  EXPECT_FALSE(o.odom) << "publish_null_when_lost: nothing is published for a lost frame";
+  srv.request.config.bools[0].value = false;
+  ASSERT_TRUE(ros::service::call("acvo/set_parameters", srv));
+}
+
+TEST(OdometryNodelet, MissingBaseTransformIsReportedNotReplacedByIdentity) {
+  if (!client->late_base_tf_) GTEST_SKIP() << "needs a .test without the base transform";
+  ASSERT_TRUE(client->reset());
+  // No transform from the base to the camera yet: the odometry runs, nothing is published.
+  std::vector<Outcome> without = client->run(range(0, 3));
+  for (const Outcome& o : without) {
+    ASSERT_TRUE(o.info);
+    EXPECT_FALSE(o.odom) << "published without the base transform";
+  }
+  // The transform appears: the next frames are published, conjugated by it, and continue the
+  // motion measured meanwhile.
+  tf2_ros::StaticTransformBroadcaster broadcaster;
+  geometry_msgs::TransformStamped t = tf2::eigenToTransform(client->base_from_camera_);
+  t.header.stamp = ros::Time::now();
+  t.header.frame_id = client->base_frame_;
+  t.child_frame_id = acvo_ros::stripSlash(client->camera_frame_);
+  broadcaster.sendTransform(t);
+  ros::WallDuration(0.5).sleep();
+  std::vector<Outcome> with = client->run(range(3, 6));
+  ASSERT_TRUE(with.back().odom);
+  EXPECT_EQ(with.back().odom->child_frame_id, client->base_frame_);
+  expectPoseNear(with.back().odom->pose.pose, client->expectedBase(cameraPose(5)), 5,
+                 "after the base transform arrived");
 }
 
 TEST(OdometryNodelet, NoDataIsAnError) {
