@@ -167,8 +167,11 @@ SynthFrame renderBlurred(const Scene& scene, const Eigen::Isometry3d& pose,
   if (exposure.empty()) return render(scene, pose, options, seed);
   const RayCast exact = rayCast(scene, options.camera, pose);
   cv::Mat sum(exact.colour.size(), CV_32FC3, cv::Scalar::all(0));
-  for (const Eigen::Isometry3d& sub_pose : exposure)
-    sum += rayCast(scene, options.camera, sub_pose).colour;
+  for (const Eigen::Isometry3d& sub_pose : exposure) {
+    // The middle of an odd number of sub-frames is usually the frame's own pose.
+    const bool same = sub_pose.matrix() == pose.matrix();
+    sum += same ? exact.colour : rayCast(scene, options.camera, sub_pose).colour;
+  }
   cv::Mat colour = sum / static_cast<double>(exposure.size());
   return finish(pose, options, seed, exact, colour);
 }
