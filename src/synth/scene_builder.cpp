@@ -140,8 +140,8 @@ void addFurniture(Scene& scene, Rng& rng, int first_material) {
     const Eigen::Vector3d centre{rng.uniform(-1.5, 1.5), kRoomMax.y() - 0.03,
                                  rng.uniform(1.2, 1.8)};
     const double half_w = rng.uniform(0.4, 0.7), half_h = rng.uniform(0.3, 0.5);
-    scene.quads.push_back(makeQuad(centre, Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitZ(),
-                                   half_w, half_h, m++));
+    scene.quads.push_back(
+        makeQuad(centre, Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitZ(), half_w, half_h, m++));
   }
 }
 
