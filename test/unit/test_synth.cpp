@@ -226,7 +226,7 @@ TEST(SynthNoise, DepthNoiseGrowsWithDepthAndEdgesDropOut) {
   struct Band {
     double lo, hi, sum2 = 0;
     int n = 0;
-  } bands[2] = {{1.8, 2.4}, {3.8, 4.8}};
+  } bands[2] = {{1.6, 2.0}, {2.9, 3.4}};
   int edge_pixels = 0, edge_dropped = 0, interior = 0, interior_valid = 0;
   for (int v = 1; v + 1 < f.camera.height; ++v) {
     for (int u = 1; u + 1 < f.camera.width; ++u) {
@@ -250,9 +250,9 @@ TEST(SynthNoise, DepthNoiseGrowsWithDepthAndEdgesDropOut) {
   const double near_std = std::sqrt(bands[0].sum2 / bands[0].n);
   const double far_std = std::sqrt(bands[1].sum2 / bands[1].n);
   const KinectNoise model;
-  EXPECT_GT(near_std, model.depthSigma(1.8));
-  EXPECT_LT(near_std, 2.0 * model.depthSigma(2.4));
-  EXPECT_GT(far_std, 2.5 * near_std) << "near " << near_std << " far " << far_std;
+  EXPECT_GT(near_std, model.depthSigma(1.6));
+  EXPECT_LT(near_std, 2.0 * model.depthSigma(2.0));
+  EXPECT_GT(far_std, 2.2 * near_std) << "near " << near_std << " far " << far_std;
   EXPECT_GT(edge_pixels, 500);
   EXPECT_EQ(edge_dropped, edge_pixels);
   EXPECT_GT(interior_valid, 0.99 * interior);
