@@ -61,11 +61,21 @@ class CrossKernel {
     int i;
     float a;
   };
+  // Work and results for a fixed range of moving points (the unit of parallelism).
   struct Chunk {
-    std::vector<Pair> pairs;
-    std::vector<int> pair_end;  // per moving point of the chunk: end index into pairs
+    // Candidate fixed points of each moving point: every fixed point within the list radius of
+    // where the moving point was when the lists were built, whose colour factor lets it pass
+    // the threshold at distance 0. Colour does not depend on T: its factor is cached here.
+    std::vector<int> cand_end;      // per moving point of the chunk: end index into cand_*
+    std::vector<int> cand_i;
+    std::vector<float> cand_color;  // sigma_c^2 exp(-|f_i - g_j|^2 / 2 l_c^2)
+    std::vector<Pair> pairs;        // kept pairs of the last evaluate()
+    std::vector<int> pair_end;      // per moving point of the chunk: end index into pairs
     CrossSums sums;
   };
+
+  // Rebuilds the candidate lists around the moving points placed by T, for radius `radius`.
+  void buildCandidates(const Eigen::Isometry3d& T, float radius);
 
   const PreparedCloud& fixed_;
   const PreparedCloud& moving_;
@@ -74,6 +84,16 @@ class CrossKernel {
   std::vector<Eigen::Vector3f> y_;  // transformed moving points
   std::vector<Chunk> chunks_;
   CrossSums sums_;
+  // Candidate lists stay valid while every moving point stays within list_radius_ - r of where
+  // it was at list_T_ (r: the current search radius).
+  bool lists_valid_ = false;
+  Eigen::Isometry3d list_T_ = Eigen::Isometry3d::Identity();
+  float list_radius_ = 0.0f;
+  float max_point_norm_ = 0.0f;  // max |z_j| of the moving cloud
+  int list_builds_ = 0;
+
+ public:
+  int candidateListBuilds() const { return list_builds_; }
 };
 
 }  // namespace acvo

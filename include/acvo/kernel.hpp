@@ -62,6 +62,8 @@ struct PreparedCloud {
   LabelledCloud cloud;
   VoxelGrid grid;                 // cell = the search radius at the largest length-scale
   std::vector<SelfPair> self_pairs;  // all pairs within that radius that can pass the threshold
+  // The same pairs' d2 and colour factors as arrays, for vectorised sums per iteration.
+  Eigen::ArrayXf self_d2, self_color;
   double ms_prepare = 0.0;
 
   std::size_t size() const { return cloud.size(); }

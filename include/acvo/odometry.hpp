@@ -34,6 +34,7 @@ struct OdometryResult {
   std::size_t fixed_points = 0;
   std::size_t moving_points = 0;
   double ms_cloud = 0.0;         // building this frame's cloud (selection + labels + self-kernel)
+  double ms_prepare = 0.0;       // of which: search grid + self-kernel pairs
   double ms_registration = 0.0;  // the solver
   CloudStats cloud_stats;
 };

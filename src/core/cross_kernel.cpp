@@ -40,6 +40,16 @@ SelfSums selfKernelSums(const PreparedCloud& cloud, double ell, const SolverPara
     s.sum += rows * diag;
     s.nnz += rows;
   }
+  if (first_row <= 0) {
+    // Every pair counts twice, (i, j) and (j, i): vectorised over the pair arrays.
+    const Eigen::ArrayXf a =
+        float(sigma2) * (cloud.self_d2 * float(-inv)).exp() * cloud.self_color;
+    const auto kept = (a >= float(sp));
+    s.sum += 2.0 * kept.select(a, 0.0f).cast<double>().sum();
+    s.sum_d2 += 2.0 * kept.select(a * cloud.self_d2, 0.0f).cast<double>().sum();
+    s.nnz += 2 * std::int64_t(kept.count());
+    return s;
+  }
   for (const auto& q : cloud.self_pairs) {
     const double a = sigma2 * std::exp(-q.d2 * inv) * q.color;
     if (a < sp) continue;
@@ -57,14 +67,13 @@ CrossKernel::CrossKernel(const PreparedCloud& fixed, const PreparedCloud& moving
     : fixed_(fixed), moving_(moving), params_(params) {
   y_.resize(moving_.size());
   chunks_.resize((moving_.size() + kChunk - 1) / kChunk);
+  for (const auto& z : moving_.cloud.points) max_point_norm_ = std::max(max_point_norm_, z.norm());
 }
 
-const CrossSums& CrossKernel::evaluate(const Eigen::Isometry3d& T, double ell) {
-  ell_ = ell;
+void CrossKernel::buildCandidates(const Eigen::Isometry3d& T, float radius) {
   const Eigen::Matrix3f R = T.linear().cast<float>();
   const Eigen::Vector3f t = T.translation().cast<float>();
-  const float r2 = float(spatialRadius2(ell, params_.sigma, params_.sparsification));
-  const float inv = float(1.0 / (2.0 * ell * ell));
+  const float radius2 = radius * radius;
   const float sigma2 = float(params_.sigma * params_.sigma);
   const float color_sigma2 = float(params_.color_sigma * params_.color_sigma);
   const float color_inv = float(1.0 / (2.0 * params_.color_ell * params_.color_ell));
@@ -74,34 +83,87 @@ const CrossSums& CrossKernel::evaluate(const Eigen::Isometry3d& T, double ell) {
   const auto& Z = moving_.cloud.points;
   const auto& gz = moving_.cloud.labels;
   const int n = int(Z.size());
+  forEachChunk(int(chunks_.size()), [&](int c) {
+    Chunk& chunk = chunks_[c];
+    chunk.cand_end.clear();
+    chunk.cand_i.clear();
+    chunk.cand_color.clear();
+    const int end = std::min(n, (c + 1) * kChunk);
+    for (int j = c * kChunk; j < end; ++j) {
+      const Eigen::Vector3f y = R * Z[j] + t;
+      fixed_.grid.forEachCandidate(y, [&](int i) {
+        if (!((X[i] - y).squaredNorm() < radius2)) return;
+        const float cf = colorFactor(fx[i], gz[j], color_inv, color_sigma2);
+        if (sigma2 * cf < sp) return;  // fails at any distance
+        chunk.cand_i.push_back(i);
+        chunk.cand_color.push_back(cf);
+      });
+      chunk.cand_end.push_back(int(chunk.cand_i.size()));
+    }
+  });
+  list_T_ = T;
+  list_radius_ = radius;
+  lists_valid_ = true;
+  ++list_builds_;
+}
+
+const CrossSums& CrossKernel::evaluate(const Eigen::Isometry3d& T, double ell) {
+  ell_ = ell;
+  const double r2_exact = spatialRadius2(ell, params_.sigma, params_.sparsification);
+  const float r = float(std::sqrt(std::min(r2_exact, 1e6)));
+  // How far any moving point can have moved since the lists were built: |dR z + dt| is at most
+  // ||dR||_F |z|max + |dt|.
+  const float moved =
+      lists_valid_ ? float((T.linear() - list_T_.linear()).norm() * max_point_norm_ +
+                           (T.translation() - list_T_.translation()).norm())
+                   : INFINITY;
+  // Lists are built with a margin so that several iterations reuse them; they are rebuilt when
+  // a point may have left the margin, or when the radius has shrunk enough that the lists carry
+  // mostly useless candidates. The margin never exceeds the grid cell (the grid only
+  // guarantees neighbours within one cell).
+  const float cell = fixed_.grid.cell();
+  if (r + moved > list_radius_ || list_radius_ > 1.6f * r + 0.005f) {
+    buildCandidates(T, std::min(1.3f * r + 0.002f, std::max(cell, r)));
+  }
+
+  const Eigen::Matrix3f R = T.linear().cast<float>();
+  const Eigen::Vector3f t = T.translation().cast<float>();
+  const float r2 = r * r;
+  const float inv = float(1.0 / (2.0 * ell * ell));
+  const float sigma2 = float(params_.sigma * params_.sigma);
+  const float sp = float(params_.sparsification);
+  const auto& X = fixed_.cloud.points;
+  const auto& Z = moving_.cloud.points;
+  const int n = int(Z.size());
 
   forEachChunk(int(chunks_.size()), [&](int c) {
     Chunk& chunk = chunks_[c];
     chunk.pairs.clear();
     chunk.pair_end.clear();
-    // Per-chunk accumulation in double; the chunk's points are few, float terms are exact enough.
+    // Per-chunk accumulation in double; one point's few terms are summed in float.
     Eigen::Vector3d omega = Eigen::Vector3d::Zero(), v = Eigen::Vector3d::Zero();
     double F = 0.0, F_d2 = 0.0;
+    int k = 0;
     const int end = std::min(n, (c + 1) * kChunk);
     for (int j = c * kChunk; j < end; ++j) {
       const Eigen::Vector3f y = R * Z[j] + t;
       y_[j] = y;
       Eigen::Vector3f cross_sum = Eigen::Vector3f::Zero(), diff_sum = Eigen::Vector3f::Zero();
       float a_sum = 0.0f, ad2_sum = 0.0f;
-      fixed_.grid.forEachCandidate(y, [&](int i) {
+      const int k_end = chunk.cand_end[j - c * kChunk];
+      for (; k < k_end; ++k) {
+        const int i = chunk.cand_i[k];
         const Eigen::Vector3f d = y - X[i];
         const float d2 = d.squaredNorm();
-        if (!(d2 < r2)) return;
-        const float ks = sigma2 * std::exp(-d2 * inv);
-        if (ks * color_sigma2 < sp) return;
-        const float a = ks * colorFactor(fx[i], gz[j], color_inv, color_sigma2);
-        if (a < sp) return;
+        if (!(d2 < r2)) continue;
+        const float a = sigma2 * std::exp(-d2 * inv) * chunk.cand_color[k];
+        if (a < sp) continue;
         chunk.pairs.push_back({i, a});
         cross_sum += a * X[i].cross(y);
         diff_sum += a * d;
         a_sum += a;
         ad2_sum += a * d2;
-      });
+      }
       chunk.pair_end.push_back(int(chunk.pairs.size()));
       omega += cross_sum.cast<double>();
       v += diff_sum.cast<double>();

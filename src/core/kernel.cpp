@@ -87,7 +87,9 @@ PreparedCloud prepareCloud(LabelledCloud cloud, const SolverParams& p) {
   PreparedCloud out;
   out.cloud = std::move(cloud);
   const double r2 = spatialRadius2(largestEll(p), p.sigma, p.sparsification);
-  const float cell = std::isfinite(r2) && r2 > 0.0 ? float(std::sqrt(r2)) : 0.1f;
+  // Cells a little larger than the largest search radius: the solver's candidate lists carry a
+  // margin beyond the radius and the grid only guarantees neighbours within one cell.
+  const float cell = std::isfinite(r2) && r2 > 0.0 ? 1.3f * float(std::sqrt(r2)) + 0.002f : 0.1f;
   out.grid = VoxelGrid(out.cloud.points, cell);
 
   const float sigma2 = float(p.sigma * p.sigma);
@@ -106,6 +108,12 @@ PreparedCloud prepareCloud(LabelledCloud cloud, const SolverParams& p) {
       if (sigma2 * c < sp) return;
       out.self_pairs.push_back({i, j, d2, c});
     });
+  }
+  out.self_d2.resize(Eigen::Index(out.self_pairs.size()));
+  out.self_color.resize(Eigen::Index(out.self_pairs.size()));
+  for (std::size_t k = 0; k < out.self_pairs.size(); ++k) {
+    out.self_d2[Eigen::Index(k)] = out.self_pairs[k].d2;
+    out.self_color[Eigen::Index(k)] = out.self_pairs[k].color;
   }
   out.ms_prepare =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

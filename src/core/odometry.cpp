@@ -62,6 +62,7 @@ OdometryResult Odometry::process(const Frame& frame) {
   });
   r.ms_cloud = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
   r.moving_points = current->size();
+  r.ms_prepare = current->ms_prepare;
 
   if (!reference_) {
     reference_ = std::move(current);

@@ -4,6 +4,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <opencv2/imgproc.hpp>
 
 #include "synth/random.hpp"
 
@@ -14,39 +15,32 @@ namespace {
 constexpr std::uint64_t kDepthStream = 0x4445505448ull;
 constexpr std::uint64_t kColourStream = 0x434f4c4f5552ull;
 
-bool atDiscontinuity(const cv::Mat& exact, int u, int v, float z, double jump) {
-  for (int dv = -1; dv <= 1; ++dv) {
-    const int y = v + dv;
-    if (y < 0 || y >= exact.rows) continue;
-    const float* row = exact.ptr<float>(y);
-    for (int du = -1; du <= 1; ++du) {
-      const int x = u + du;
-      if (x < 0 || x >= exact.cols) continue;
-      const float n = row[x];
-      if (n <= 0.0f || std::abs(n - z) > jump) return true;
-    }
-  }
-  return false;
-}
-
 }  // namespace
 
 cv::Mat degradeDepth(const cv::Mat& exact, const KinectNoise& noise, double depth_scale,
                      std::uint64_t seed) {
   CV_Assert(exact.type() == CV_32FC1);
   cv::Mat out(exact.size(), CV_32FC1, cv::Scalar(0));
+  // Extremes of each 3x3 neighbourhood (replicated border: only pixels in the image count),
+  // to find discontinuities: a neighbour without depth, or one farther than the jump.
+  cv::Mat lowest, highest;
+  const cv::Mat box = cv::Mat::ones(3, 3, CV_8U);
+  cv::erode(exact, lowest, box, {-1, -1}, 1, cv::BORDER_REPLICATE);
+  cv::dilate(exact, highest, box, {-1, -1}, 1, cv::BORDER_REPLICATE);
   const std::uint64_t stream = hashCombine(seed, kDepthStream);
   tbb::parallel_for(tbb::blocked_range<int>(0, exact.rows), [&](const tbb::blocked_range<int>& r) {
     for (int v = r.begin(); v < r.end(); ++v) {
       Rng rng(hashCombine(stream, v));
       const float* in = exact.ptr<float>(v);
+      const float* lo = lowest.ptr<float>(v);
+      const float* hi = highest.ptr<float>(v);
       float* o = out.ptr<float>(v);
       for (int u = 0; u < exact.cols; ++u) {
         const double gaussian = rng.pixelNoise();  // drawn for every pixel: fixed stream layout
         const float z = in[u];
         if (!(z > 0.0f)) continue;
         const double jump = noise.edge_jump_base + noise.edge_jump_quadratic * z * z;
-        if (atDiscontinuity(exact, u, v, z, jump)) continue;
+        if (!(lo[u] > 0.0f) || hi[u] - z > jump || z - lo[u] > jump) continue;
         double measured = z + noise.depthSigma(z) * gaussian;
         if (measured <= 0.0) continue;
         if (noise.disparity_step > 0.0) {
@@ -72,7 +66,8 @@ void addColourNoise(cv::Mat& colour, double sigma, std::uint64_t seed) {
     for (int v = r.begin(); v < r.end(); ++v) {
       Rng rng(hashCombine(stream, v));
       float* p = colour.ptr<float>(v);
-      for (int i = 0; i < 3 * colour.cols; ++i) p[i] += static_cast<float>(sigma * rng.pixelNoise());
+      for (int i = 0; i < 3 * colour.cols; ++i)
+        p[i] += static_cast<float>(sigma * rng.pixelNoise());
     }
   });
 }

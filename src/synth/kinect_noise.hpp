@@ -19,9 +19,9 @@
 namespace acvo::synth {
 
 struct KinectNoise {
-  double sigma_base = 0.0012;       // m; sigma(z) = base + quadratic * (z - offset)^2
-  double sigma_quadratic = 0.0019;  // 1/m
-  double sigma_offset = 0.4;        // m
+  double sigma_base = 0.0012;             // m; sigma(z) = base + quadratic * (z - offset)^2
+  double sigma_quadratic = 0.0019;        // 1/m
+  double sigma_offset = 0.4;              // m
   double focal_baseline = 580.0 * 0.075;  // px * m, for the disparity d = focal_baseline / z
   double disparity_step = 1.0 / 8.0;      // px
   double min_depth = 0.4;                 // m; nearer -> 0

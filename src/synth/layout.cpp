@@ -15,6 +15,8 @@ Eigen::Isometry3d lookAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& targ
   return pose;
 }
 
-Eigen::Isometry3d defaultStartPose() { return lookAt(kStartEye, kLookAtTarget); }
+Eigen::Isometry3d defaultStartPose() {
+  return lookAt(kStartEye, kLookAtTarget);
+}
 
 }  // namespace acvo::synth

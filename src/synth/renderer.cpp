@@ -118,38 +118,40 @@ RayCast rayCast(const Scene& scene, const Camera& camera, const Eigen::Isometry3
   const std::vector<PixelRect> bounds = primitiveBounds(scene, camera, pose);
   const Eigen::Matrix3d R = pose.linear();
   const double focal = std::sqrt(camera.fx * camera.fy);
-  tbb::parallel_for(tbb::blocked_range<int>(0, camera.height), [&](const tbb::blocked_range<int>& r) {
-    std::vector<int> in_row, candidates(bounds.size());
-    for (int v = r.begin(); v < r.end(); ++v) {
-      in_row.clear();
-      for (int p = 0; p < static_cast<int>(bounds.size()); ++p)
-        if (bounds[p].v0 <= v && v <= bounds[p].v1) in_row.push_back(p);
-      auto* colour = out.colour.ptr<cv::Vec3f>(v);
-      auto* depth = out.depth.ptr<float>(v);
-      auto* surface = out.surface.ptr<int>(v);
-      const double y = (v - camera.cy) / camera.fy;
-      for (int u = 0; u < camera.width; ++u) {
-        int count = 0;
-        for (int p : in_row)
-          if (bounds[p].u0 <= u && u <= bounds[p].u1) candidates[count++] = p;
-        // Camera-frame direction with unit z: the hit's t is its depth.
-        const Eigen::Vector3d direction = R * Eigen::Vector3d((u - camera.cx) / camera.fx, y, 1.0);
-        Hit hit;
-        if (!caster.cast(direction, &hit, candidates.data(), count)) {
-          colour[u] = cv::Vec3f(0, 0, 0);
-          depth[u] = 0.0f;
-          surface[u] = -1;
-          continue;
-        }
-        const Eigen::Vector3d c =
-            surfaceColour(scene.materials[hit.material], hit.uv.x(), hit.uv.y(),
-                          pixelFootprint(hit, direction, focal), hit.brightness);
-        colour[u] = cv::Vec3f(c.x(), c.y(), c.z());
-        depth[u] = static_cast<float>(hit.t);
-        surface[u] = hit.surface;
-      }
-    }
-  });
+  tbb::parallel_for(tbb::blocked_range<int>(0, camera.height),
+                    [&](const tbb::blocked_range<int>& r) {
+                      std::vector<int> in_row, candidates(bounds.size());
+                      for (int v = r.begin(); v < r.end(); ++v) {
+                        in_row.clear();
+                        for (int p = 0; p < static_cast<int>(bounds.size()); ++p)
+                          if (bounds[p].v0 <= v && v <= bounds[p].v1) in_row.push_back(p);
+                        auto* colour = out.colour.ptr<cv::Vec3f>(v);
+                        auto* depth = out.depth.ptr<float>(v);
+                        auto* surface = out.surface.ptr<int>(v);
+                        const double y = (v - camera.cy) / camera.fy;
+                        for (int u = 0; u < camera.width; ++u) {
+                          int count = 0;
+                          for (int p : in_row)
+                            if (bounds[p].u0 <= u && u <= bounds[p].u1) candidates[count++] = p;
+                          // Camera-frame direction with unit z: the hit's t is its depth.
+                          const Eigen::Vector3d direction =
+                              R * Eigen::Vector3d((u - camera.cx) / camera.fx, y, 1.0);
+                          Hit hit;
+                          if (!caster.cast(direction, &hit, candidates.data(), count)) {
+                            colour[u] = cv::Vec3f(0, 0, 0);
+                            depth[u] = 0.0f;
+                            surface[u] = -1;
+                            continue;
+                          }
+                          const Eigen::Vector3d c =
+                              surfaceColour(scene.materials[hit.material], hit.uv.x(), hit.uv.y(),
+                                            pixelFootprint(hit, direction, focal), hit.brightness);
+                          colour[u] = cv::Vec3f(c.x(), c.y(), c.z());
+                          depth[u] = static_cast<float>(hit.t);
+                          surface[u] = hit.surface;
+                        }
+                      }
+                    });
   return out;
 }
 
@@ -165,8 +167,11 @@ SynthFrame renderBlurred(const Scene& scene, const Eigen::Isometry3d& pose,
   if (exposure.empty()) return render(scene, pose, options, seed);
   const RayCast exact = rayCast(scene, options.camera, pose);
   cv::Mat sum(exact.colour.size(), CV_32FC3, cv::Scalar::all(0));
-  for (const Eigen::Isometry3d& sub_pose : exposure)
-    sum += rayCast(scene, options.camera, sub_pose).colour;
+  for (const Eigen::Isometry3d& sub_pose : exposure) {
+    // The middle of an odd number of sub-frames is usually the frame's own pose.
+    const bool same = sub_pose.matrix() == pose.matrix();
+    sum += same ? exact.colour : rayCast(scene, options.camera, sub_pose).colour;
+  }
   cv::Mat colour = sum / static_cast<double>(exposure.size());
   return finish(pose, options, seed, exact, colour);
 }

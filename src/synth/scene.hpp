@@ -101,9 +101,9 @@ class RayCaster {
  private:
   struct PreparedQuad {
     Eigen::Vector3d normal;
-    double numerator;            // normal . (centre - origin)
+    double numerator;  // normal . (centre - origin)
     Eigen::Vector3d axis_s, axis_t;
-    double s0, t0;               // texture coordinates of the origin's projection
+    double s0, t0;  // texture coordinates of the origin's projection
     double half_s, half_t;
   };
   struct PreparedBox {

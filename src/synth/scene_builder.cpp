@@ -1,5 +1,9 @@
 // makeScene: the furnished room (structure on) or the single plane (structure off), with
 // seeded materials.
+//
+// Random draws are made one per statement or in braced lists (evaluated left to right):
+// function arguments are evaluated in an unspecified order, and a seed must give the same
+// scene with any compiler.
 #include <cmath>
 #include <limits>
 
@@ -16,12 +20,18 @@ Eigen::Vector3d bgrFromHsv(double hue_deg, double s, double v) {
   const double h = std::fmod(std::fmod(hue_deg, 360.0) + 360.0, 360.0) / 60.0;
   const double c = v * s, x = c * (1.0 - std::abs(std::fmod(h, 2.0) - 1.0)), m = v - c;
   Eigen::Vector3d rgb;
-  if (h < 1) rgb = {c, x, 0};
-  else if (h < 2) rgb = {x, c, 0};
-  else if (h < 3) rgb = {0, c, x};
-  else if (h < 4) rgb = {0, x, c};
-  else if (h < 5) rgb = {x, 0, c};
-  else rgb = {c, 0, x};
+  if (h < 1)
+    rgb = {c, x, 0};
+  else if (h < 2)
+    rgb = {x, c, 0};
+  else if (h < 3)
+    rgb = {0, c, x};
+  else if (h < 4)
+    rgb = {0, x, c};
+  else if (h < 5)
+    rgb = {x, 0, c};
+  else
+    rgb = {c, 0, x};
   rgb.array() += m;
   return 255.0 * Eigen::Vector3d(rgb.z(), rgb.y(), rgb.x());
 }
@@ -30,10 +40,12 @@ Eigen::Vector3d bgrFromHsv(double hue_deg, double s, double v) {
 Material makeMaterial(Rng& rng, bool textured, Pattern pattern, double period,
                       std::uint64_t noise_seed) {
   Material m;
-  const double hue = rng.uniform(0.0, 360.0);
-  m.base = bgrFromHsv(hue, rng.uniform(0.25, 0.75), rng.uniform(0.45, 0.9));
-  m.accent = bgrFromHsv(hue + rng.uniform(40.0, 140.0), rng.uniform(0.2, 0.8),
-                        rng.uniform(0.15, 0.6));
+  const double hsv_base[3] = {rng.uniform(0.0, 360.0), rng.uniform(0.25, 0.75),
+                              rng.uniform(0.45, 0.9)};
+  const double hsv_accent[3] = {hsv_base[0] + rng.uniform(40.0, 140.0), rng.uniform(0.2, 0.8),
+                                rng.uniform(0.15, 0.6)};
+  m.base = bgrFromHsv(hsv_base[0], hsv_base[1], hsv_base[2]);
+  m.accent = bgrFromHsv(hsv_accent[0], hsv_accent[1], hsv_accent[2]);
   m.textured = textured;
   m.noise_wavelength = rng.uniform(0.6, 1.2);
   m.pattern = pattern;
@@ -99,15 +111,16 @@ void addFurniture(Scene& scene, Rng& rng, int first_material) {
   }
   {  // a smaller box on top of a floor box
     const Box& base = scene.boxes[rng.index(kFloorBoxes)];
-    const Eigen::Vector3d half = base.half_size.cwiseProduct(
-        Eigen::Vector3d(rng.uniform(0.4, 0.7), rng.uniform(0.4, 0.7), rng.uniform(0.5, 1.0)));
-    const Eigen::Vector3d centre = base.box_to_world.translation() +
-                                   Eigen::Vector3d(0, 0, base.half_size.z() + half.z());
+    const Eigen::Vector3d shrink{rng.uniform(0.4, 0.7), rng.uniform(0.4, 0.7),
+                                 rng.uniform(0.5, 1.0)};
+    const Eigen::Vector3d half = base.half_size.cwiseProduct(shrink);
+    const Eigen::Vector3d centre =
+        base.box_to_world.translation() + Eigen::Vector3d(0, 0, base.half_size.z() + half.z());
     scene.boxes.push_back(makeBox(centre, yaw(rng.uniform(0.0, M_PI)), half, m++));
   }
   {  // a box tilted about all three axes, in the air above the furniture
-    const Eigen::Vector3d axis =
-        Eigen::Vector3d(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)).normalized();
+    const Eigen::Vector3d direction{rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)};
+    const Eigen::Vector3d axis = direction.normalized();
     const Eigen::Matrix3d rotation =
         Eigen::AngleAxisd(rng.uniform(0.4, 1.2), axis).toRotationMatrix();
     const Eigen::Vector3d centre{rng.uniform(-1.5, 1.5), rng.uniform(1.2, 2.2),
@@ -126,8 +139,9 @@ void addFurniture(Scene& scene, Rng& rng, int first_material) {
   {  // a poster a few centimetres in front of the far wall
     const Eigen::Vector3d centre{rng.uniform(-1.5, 1.5), kRoomMax.y() - 0.03,
                                  rng.uniform(1.2, 1.8)};
-    scene.quads.push_back(makeQuad(centre, Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitZ(),
-                                   rng.uniform(0.4, 0.7), rng.uniform(0.3, 0.5), m++));
+    const double half_w = rng.uniform(0.4, 0.7), half_h = rng.uniform(0.3, 0.5);
+    scene.quads.push_back(
+        makeQuad(centre, Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitZ(), half_w, half_h, m++));
   }
 }
 

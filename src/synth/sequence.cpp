@@ -7,8 +7,8 @@
 #include <sstream>
 #include <stdexcept>
 
-#include <opencv2/imgcodecs.hpp>
 #include <tbb/parallel_for.h>
+#include <opencv2/imgcodecs.hpp>
 
 #include "synth/random.hpp"
 #include "synth/tum_writer.hpp"
@@ -33,8 +33,8 @@ std::string describe(const SequenceOptions& o) {
   s << "synthetic sequence (acvo_synth): motion " << toString(o.motion) << ", speed " << o.speed
     << " m/s, rate " << o.rate << " Hz, seed " << o.seed << ", structure "
     << (o.structure ? "on" : "off") << ", texture " << (o.texture ? "on" : "off") << ", noise "
-    << (o.noise ? "on" : "off") << ", blur " << (o.blur ? "on" : "off") << ", "
-    << o.camera.width << "x" << o.camera.height;
+    << (o.noise ? "on" : "off") << ", blur " << (o.blur ? "on" : "off") << ", " << o.camera.width
+    << "x" << o.camera.height;
   return s.str();
 }
 
@@ -98,8 +98,7 @@ SynthFrame SynthSequence::frame(int i) const {
     std::vector<Eigen::Isometry3d> exposure;
     const double t = i / options_.rate, shutter = options_.exposure / options_.rate;
     for (int k = 0; k < options_.blur_samples; ++k)
-      exposure.push_back(
-          motion_.poseAt(t + shutter * (k / (options_.blur_samples - 1.0) - 0.5)));
+      exposure.push_back(motion_.poseAt(t + shutter * (k / (options_.blur_samples - 1.0) - 0.5)));
     f = renderBlurred(scene_, poses_[i], exposure, render_options, noise_seed);
   } else {
     f = render(scene_, poses_[i], render_options, noise_seed);
@@ -129,7 +128,8 @@ void writeSequence(const std::string& folder, const SequenceOptions& options,
   std::error_code error;
   for (const char* sub : {"rgb", "depth"}) {
     fs::create_directories(fs::path(folder) / sub, error);
-    if (error) throw std::runtime_error("cannot create " + folder + "/" + sub + ": " + error.message());
+    if (error)
+      throw std::runtime_error("cannot create " + folder + "/" + sub + ": " + error.message());
   }
 
   const int n = sequence.size();
@@ -163,7 +163,8 @@ void writeSequence(const std::string& folder, const SequenceOptions& options,
   writeAssociations((root / "associations.txt").string(), about, rgb, depth);
   writeGroundtruth((root / "groundtruth.txt").string(),
                    "ground truth trajectory: camera-to-world, optical frame (x right, y down, "
-                   "z forward)\n" + about,
+                   "z forward)\n" +
+                       about,
                    stamps, sequence.poses());
   saveCameraYaml((root / "camera.yaml").string(), options.camera);
 }

@@ -33,9 +33,9 @@ struct SequenceOptions {
   bool texture = true;
   bool noise = true;
   bool blur = false;
-  int blur_samples = 5;       // sub-frame renders averaged per blurred frame
-  double exposure = 0.5;      // shutter time as a fraction of the frame interval (blur)
-  Camera camera;              // TUM default intrinsics, 640x480, depth scale 5000
+  int blur_samples = 5;         // sub-frame renders averaged per blurred frame
+  double exposure = 0.5;        // shutter time as a fraction of the frame interval (blur)
+  Camera camera;                // TUM default intrinsics, 640x480, depth scale 5000
   double first_stamp = 1000.0;  // seconds; frame i is at first_stamp + i / rate
 
   SceneOptions sceneOptions() const { return {structure, texture, seed}; }

@@ -19,11 +19,25 @@ double latticeValue(std::int64_t ix, std::int64_t iy, std::uint64_t seed) {
   return static_cast<double>(h >> 11) * 0x1.0p-53;
 }
 
-double quintic(double f) { return f * f * f * (f * (f * 6.0 - 15.0) + 10.0); }
+double quintic(double f) {
+  return f * f * f * (f * (f * 6.0 - 15.0) + 10.0);
+}
+
+// valueNoise's body, inlinable into the octave loop (texturing dominates rendering time).
+inline double noiseAt(double x, double y, std::uint64_t seed) {
+  const double fx = std::floor(x), fy = std::floor(y);
+  const auto ix = static_cast<std::int64_t>(fx), iy = static_cast<std::int64_t>(fy);
+  const double u = quintic(x - fx), v = quintic(y - fy);
+  const double a = latticeValue(ix, iy, seed), b = latticeValue(ix + 1, iy, seed);
+  const double c = latticeValue(ix, iy + 1, seed), d = latticeValue(ix + 1, iy + 1, seed);
+  return (a + (b - a) * u) * (1.0 - v) + (c + (d - c) * u) * v;
+}
 
 constexpr int kCoarseOctaves = 4;  // the rest of Material::noise_octaves are grain
 
-double clamp01(double x) { return std::clamp(x, 0.0, 1.0); }
+double clamp01(double x) {
+  return std::clamp(x, 0.0, 1.0);
+}
 
 // Weight of a feature of `wavelength` seen with pixels of `footprint`: 1 when it spans at
 // least four pixels, 0 at two pixels or less (where it could only alias).
@@ -47,7 +61,7 @@ double fractalNoise(std::uint64_t seed, double s, double t, double footprint, do
   for (int k = 0; k < octaves; ++k) {
     const double w = detailWeight(wavelength, footprint);
     // Each octave gets its own lattice (seed + k) so octaves do not line up.
-    const double n = w > 0.0 ? valueNoise(s / wavelength, t / wavelength, seed + k) : 0.5;
+    const double n = w > 0.0 ? noiseAt(s / wavelength, t / wavelength, seed + k) : 0.5;
     sum += amplitude * (w * n + (1.0 - w) * 0.5);
     total += amplitude;
     amplitude *= 0.8;  // slow decay: fine octaves stay visible (gradients at many scales)
@@ -77,12 +91,7 @@ double patternValue(const Material& m, double s, double t, double footprint) {
 }  // namespace
 
 double valueNoise(double x, double y, std::uint64_t seed) {
-  const double fx = std::floor(x), fy = std::floor(y);
-  const auto ix = static_cast<std::int64_t>(fx), iy = static_cast<std::int64_t>(fy);
-  const double u = quintic(x - fx), v = quintic(y - fy);
-  const double a = latticeValue(ix, iy, seed), b = latticeValue(ix + 1, iy, seed);
-  const double c = latticeValue(ix, iy + 1, seed), d = latticeValue(ix + 1, iy + 1, seed);
-  return (a + (b - a) * u) * (1.0 - v) + (c + (d - c) * u) * v;
+  return noiseAt(x, y, seed);
 }
 
 Eigen::Vector3d surfaceColour(const Material& m, double s, double t, double footprint,
@@ -95,8 +104,8 @@ Eigen::Vector3d surfaceColour(const Material& m, double s, double t, double foot
   const double n = fractalNoise(m.seed, s, t, footprint, m.noise_wavelength, coarse);
   const double grain =
       coarse < m.noise_octaves
-          ? fractalNoise(m.seed + coarse, s, t, footprint,
-                         std::ldexp(m.noise_wavelength, -coarse), m.noise_octaves - coarse)
+          ? fractalNoise(m.seed + coarse, s, t, footprint, std::ldexp(m.noise_wavelength, -coarse),
+                         m.noise_octaves - coarse)
           : 0.5;
   const double p = patternValue(m, s, t, footprint);
   const Eigen::Vector3d colour =

@@ -9,14 +9,14 @@
 namespace acvo::synth {
 namespace {
 
-constexpr double kReferenceSpeed = 0.3;      // m/s at which the random waves' base frequencies apply
+constexpr double kReferenceSpeed = 0.3;  // m/s at which the random waves' base frequencies apply
 // Bounds on the random motion's offsets from the start over a sequence, per axis of the
 // start's camera frame (translation) and per rotation-vector component.
 constexpr double kMaxRandomOffset = 0.5;  // m
 constexpr double kMaxRandomAngle = 0.5;   // rad (29 deg)
-constexpr double kXyzAmplitude = 0.2;        // m
+constexpr double kXyzAmplitude = 0.2;     // m
 constexpr double kRpyAmplitude = 15.0 * M_PI / 180.0;
-constexpr double kCircleRadius = 0.5;        // m
+constexpr double kCircleRadius = 0.5;  // m
 
 // Back-and-forth profile on tau in [0, 1]: 0 -> +1 -> -1 -> 0 with zero velocity and
 // acceleration at both ends, so consecutive segments (one per axis) join smoothly.
@@ -54,10 +54,14 @@ std::optional<MotionKind> parseMotionKind(const std::string& name) {
 
 std::string toString(MotionKind kind) {
   switch (kind) {
-    case MotionKind::kRandom: return "random";
-    case MotionKind::kXyz: return "xyz";
-    case MotionKind::kRpy: return "rpy";
-    case MotionKind::kCircle: return "circle";
+    case MotionKind::kRandom:
+      return "random";
+    case MotionKind::kXyz:
+      return "xyz";
+    case MotionKind::kRpy:
+      return "rpy";
+    case MotionKind::kCircle:
+      return "circle";
   }
   return "?";
 }
@@ -98,8 +102,8 @@ Motion::Motion(const MotionOptions& options) : options_(options) {
   const double duration = intervals / options.rate, dt = duration / steps;
   double path = 0.0;
   for (int i = 0; i < steps; ++i)
-    path += (sumWaves(translation_waves_, (i + 1) * dt) - sumWaves(translation_waves_, i * dt))
-                .norm();
+    path +=
+        (sumWaves(translation_waves_, (i + 1) * dt) - sumWaves(translation_waves_, i * dt)).norm();
   translation_gain_ = options.speed * duration / path;
   // The angle of exp(g r(t)) is not exactly linear in g: a few fixed-point rounds settle it.
   const double target_angle = options.speed * kAngularPerLinear * duration;
@@ -128,17 +132,21 @@ Eigen::Vector3d Motion::sumWaves(const std::vector<Wave> (&waves)[3], double t) 
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   for (int axis = 0; axis < 3; ++axis)
     for (const Wave& w : waves[axis])  // minus the value at t = 0: the motion starts at zero
-      sum[axis] += w.amplitude * (std::sin(2.0 * M_PI * w.frequency * t + w.phase) -
-                                  std::sin(w.phase));
+      sum[axis] +=
+          w.amplitude * (std::sin(2.0 * M_PI * w.frequency * t + w.phase) - std::sin(w.phase));
   return sum;
 }
 
 Eigen::Isometry3d Motion::poseAt(double t) const {
   switch (options_.kind) {
-    case MotionKind::kRandom: return randomPose(t);
-    case MotionKind::kXyz: return xyzPose(t);
-    case MotionKind::kRpy: return rpyPose(t);
-    case MotionKind::kCircle: return circlePose(t);
+    case MotionKind::kRandom:
+      return randomPose(t);
+    case MotionKind::kXyz:
+      return xyzPose(t);
+    case MotionKind::kRpy:
+      return rpyPose(t);
+    case MotionKind::kCircle:
+      return circlePose(t);
   }
   return options_.start;
 }
@@ -185,8 +193,7 @@ Eigen::Isometry3d Motion::circlePose(double t) const {
   const Eigen::Vector3d eye0 = start.translation();
   const Eigen::Vector3d centre = eye0 - kCircleRadius * right;
   // The looked-at point: on the start's optical axis, as far as the room centre is.
-  const Eigen::Vector3d target =
-      eye0 + start.linear().col(2) * (kLookAtTarget - kStartEye).norm();
+  const Eigen::Vector3d target = eye0 + start.linear().col(2) * (kLookAtTarget - kStartEye).norm();
   const double phase = options_.speed * t / kCircleRadius;
   const Eigen::Vector3d eye =
       centre + kCircleRadius * (std::cos(phase) * right + std::sin(phase) * forward);

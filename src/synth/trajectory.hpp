@@ -43,8 +43,8 @@ inline constexpr double kAngularPerLinear = 80.0 * M_PI / 180.0;
 struct MotionOptions {
   MotionKind kind = MotionKind::kRandom;
   int frames = 300;
-  double rate = 30.0;   // Hz
-  double speed = 0.3;   // m/s, mean over the sequence (rpy: sets the angular speed only)
+  double rate = 30.0;      // Hz
+  double speed = 0.3;      // m/s, mean over the sequence (rpy: sets the angular speed only)
   std::uint64_t seed = 1;  // used by `random` only
   Eigen::Isometry3d start = defaultStartPose();
 };
@@ -69,7 +69,7 @@ class Motion {
 
   MotionOptions options_;
   std::vector<Wave> translation_waves_[3], rotation_waves_[3];  // random motion only
-  double translation_gain_ = 1.0, rotation_gain_ = 1.0;          // random motion only
+  double translation_gain_ = 1.0, rotation_gain_ = 1.0;         // random motion only
 };
 
 // Poses at t_i = i / rate, i = 0 .. frames-1.

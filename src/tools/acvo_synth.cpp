@@ -91,7 +91,8 @@ Arguments parseArguments(int argc, char** argv) {
       if (!(o.rate > 0) || o.rate > 1e6) throw UsageError("--rate must be within (0, 1e6] Hz");
     } else if (option == "--motion") {
       const auto kind = acvo::synth::parseMotionKind(value);
-      if (!kind) throw UsageError("--motion expects random, xyz, rpy or circle, got '" + value + "'");
+      if (!kind)
+        throw UsageError("--motion expects random, xyz, rpy or circle, got '" + value + "'");
       o.motion = *kind;
     } else if (option == "--speed") {
       o.speed = parseNumber<double>(option, value);

@@ -143,7 +143,7 @@ int main(int argc, char** argv) {
       stats.open(opt.stats);
       if (!stats) throw std::runtime_error("cannot write " + opt.stats);
       stats << "frame,stamp,tracking,status,points,fixed_points,iterations,ell,ell_at_bound,nnz,"
-               "inner_product,ms_selection,ms_labels,ms_cloud,ms_neighbours,ms_step,ms_ell,"
+               "inner_product,ms_selection,ms_labels,ms_prepare,ms_cloud,ms_neighbours,ms_step,ms_ell,"
                "ms_registration,ms_frame\n";
     }
 
@@ -187,7 +187,7 @@ int main(int argc, char** argv) {
               << acvo::toString(s.status) << ',' << r.moving_points << ',' << r.fixed_points << ','
               << s.iterations << ',' << s.ell << ',' << int(s.ell_at_bound) << ',' << s.nnz << ','
               << s.inner_product << ',' << r.cloud_stats.ms_selection << ','
-              << r.cloud_stats.ms_labels << ',' << r.ms_cloud << ',' << s.ms_neighbours << ','
+              << r.cloud_stats.ms_labels << ',' << r.ms_prepare << ',' << r.ms_cloud << ',' << s.ms_neighbours << ','
               << s.ms_step << ',' << s.ms_ell << ',' << r.ms_registration << ',' << ms << '\n';
       }
       if (progress) {

@@ -294,8 +294,3 @@ TEST(LabelledCloud, KitchenFramesBuildQuickly) {
 
 }  // namespace
 }  // namespace acvo
-
-int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  return RUN_ALL_TESTS();
-}

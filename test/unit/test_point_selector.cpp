@@ -257,8 +257,3 @@ TEST(PointSelector, KitchenFramesCountNearTarget) {
 
 }  // namespace
 }  // namespace acvo
-
-int main(int argc, char** argv) {
-  testing::InitGoogleTest(&argc, argv);
-  return RUN_ALL_TESTS();
-}

@@ -24,8 +24,8 @@ double distanceToSurface(const Scene& scene, int id, const Eigen::Vector3d& p) {
   if (id < quads) {
     const Quad& q = scene.quads[id];
     const Eigen::Vector3d r = p - q.centre;
-    const double outside = std::max({0.0, std::abs(r.dot(q.axis_s)) - q.half_s,
-                                     std::abs(r.dot(q.axis_t)) - q.half_t});
+    const double outside =
+        std::max({0.0, std::abs(r.dot(q.axis_s)) - q.half_s, std::abs(r.dot(q.axis_t)) - q.half_t});
     return std::abs(r.dot(q.normal())) + outside;
   }
   const Box& box = scene.boxes[(id - quads) / 6];
@@ -38,7 +38,9 @@ double distanceToSurface(const Scene& scene, int id, const Eigen::Vector3d& p) {
   return std::abs(local[axis] - side * box.half_size[axis]) + outside;
 }
 
-RenderOptions exactOptions() { return RenderOptions{}; }  // default camera, no noise
+RenderOptions exactOptions() {
+  return RenderOptions{};
+}  // default camera, no noise
 
 Eigen::Isometry3d somePose(int frame, std::uint64_t seed = 1) {
   MotionOptions m;
@@ -224,7 +226,7 @@ TEST(SynthNoise, DepthNoiseGrowsWithDepthAndEdgesDropOut) {
   struct Band {
     double lo, hi, sum2 = 0;
     int n = 0;
-  } bands[2] = {{1.8, 2.4}, {3.8, 4.8}};
+  } bands[2] = {{1.6, 2.0}, {2.9, 3.4}};
   int edge_pixels = 0, edge_dropped = 0, interior = 0, interior_valid = 0;
   for (int v = 1; v + 1 < f.camera.height; ++v) {
     for (int u = 1; u + 1 < f.camera.width; ++u) {
@@ -248,9 +250,9 @@ TEST(SynthNoise, DepthNoiseGrowsWithDepthAndEdgesDropOut) {
   const double near_std = std::sqrt(bands[0].sum2 / bands[0].n);
   const double far_std = std::sqrt(bands[1].sum2 / bands[1].n);
   const KinectNoise model;
-  EXPECT_GT(near_std, model.depthSigma(1.8));
-  EXPECT_LT(near_std, 2.0 * model.depthSigma(2.4));
-  EXPECT_GT(far_std, 2.5 * near_std) << "near " << near_std << " far " << far_std;
+  EXPECT_GT(near_std, model.depthSigma(1.6));
+  EXPECT_LT(near_std, 2.0 * model.depthSigma(2.0));
+  EXPECT_GT(far_std, 2.2 * near_std) << "near " << near_std << " far " << far_std;
   EXPECT_GT(edge_pixels, 500);
   EXPECT_EQ(edge_dropped, edge_pixels);
   EXPECT_GT(interior_valid, 0.99 * interior);
@@ -291,7 +293,8 @@ TEST(SynthBlur, BlurSmoothsColourButNotDepth) {
   const SynthFrame blurred = renderBlurred(scene, pose, exposure, exactOptions());
   EXPECT_EQ(cv::norm(sharp.depth_m, blurred.depth_m, cv::NORM_INF), 0.0);
   EXPECT_GT(cv::norm(sharp.bgr, blurred.bgr, cv::NORM_L1) / sharp.bgr.total(), 1.0);
-  EXPECT_LT(cv::sum(gradientMagnitude(blurred.bgr))[0], 0.9 * cv::sum(gradientMagnitude(sharp.bgr))[0]);
+  EXPECT_LT(cv::sum(gradientMagnitude(blurred.bgr))[0],
+            0.9 * cv::sum(gradientMagnitude(sharp.bgr))[0]);
   // A still camera blurs nothing.
   const SynthFrame still = renderBlurred(scene, pose, {pose, pose, pose}, exactOptions());
   EXPECT_EQ(cv::norm(sharp.bgr, still.bgr, cv::NORM_INF), 0.0);
@@ -314,7 +317,8 @@ TEST(SynthSequence, KnownRelativeMotionReprojectsDepth) {
     for (int u = 10; u < 630; u += 6) {
       const Eigen::Vector3d p = b_to_a * b.camera.backProject(u, v, b.depth_m.at<float>(v, u));
       const Eigen::Vector2d px = a.camera.project(p);
-      const int ua = static_cast<int>(std::lround(px.x())), va = static_cast<int>(std::lround(px.y()));
+      const int ua = static_cast<int>(std::lround(px.x())),
+                va = static_cast<int>(std::lround(px.y()));
       if (ua < 1 || va < 1 || ua >= 639 || va >= 479) continue;
       if (a.surface.at<int>(va, ua) != b.surface.at<int>(v, u)) continue;  // occluded or edge
       errors.push_back(std::abs(p.z() - a.depth_m.at<float>(va, ua)));

@@ -60,7 +60,7 @@ TEST(SynthTrajectory, DefaultStartLooksIntoTheRoom) {
   EXPECT_NEAR(start.linear().determinant(), 1.0, 1e-12);
   const Eigen::Vector3d forward = start.linear().col(2), down = start.linear().col(1);
   EXPECT_LT((forward - (kLookAtTarget - kStartEye).normalized()).norm(), 1e-12);
-  EXPECT_LT(down.z(), -0.9);                 // image y points down in the world
+  EXPECT_LT(down.z(), -0.9);                           // image y points down in the world
   EXPECT_NEAR(start.linear().col(0).z(), 0.0, 1e-12);  // no roll
 }
 
@@ -122,8 +122,8 @@ TEST(SynthTrajectory, StaysInTheRoomFacingTheFurniture) {
           ASSERT_TRUE((p.array() > kRoomMin.array() + 0.3).all()) << toString(kind);
           ASSERT_TRUE((p.array() < kRoomMax.array() - 0.3).all()) << toString(kind);
           ASSERT_LT(p.y(), kFurnitureMinY - 0.2) << toString(kind) << " seed " << seed;
-          const double turned = std::acos(std::clamp(
-              pose.linear().col(2).dot(start_forward), -1.0, 1.0));
+          const double turned =
+              std::acos(std::clamp(pose.linear().col(2).dot(start_forward), -1.0, 1.0));
           ASSERT_LT(turned, 45.0 * M_PI / 180.0) << toString(kind) << " seed " << seed;
           // Every ray of a 640x480, f = 525 view reaches the single plane ahead.
           for (double x : {-320.0 / 525.0, 320.0 / 525.0})

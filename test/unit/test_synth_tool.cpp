@@ -1,0 +1,165 @@
+// acvo_synth end to end: a tiny sequence on disk, its lists, groundtruth and camera file,
+// determinism, and the errors for bad options.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "acvo/camera.hpp"
+#include "synth/layout.hpp"
+#include "synth/sequence.hpp"
+#include "test_support.hpp"
+
+namespace acvo::synth {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Runs acvo_synth with `arguments`; returns its exit status.
+int runTool(const std::string& arguments) {
+  const fs::path tool = test::toolsDir() / "acvo_synth";
+  const std::string command = "'" + tool.string() + "' " + arguments + " >/dev/null 2>&1";
+  const int status = std::system(command.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+// The non-comment lines of a text file, split into words.
+std::vector<std::vector<std::string>> readRows(const fs::path& path) {
+  std::ifstream in(path);
+  EXPECT_TRUE(in) << path;
+  std::vector<std::vector<std::string>> rows;
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream words(line);
+    rows.emplace_back();
+    for (std::string w; words >> w;) rows.back().push_back(w);
+  }
+  return rows;
+}
+
+std::string readBytes(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+TEST(SynthTool, WritesAConsistentTumFolder) {
+  const fs::path out = test::tempDir("synth_tool");
+  ASSERT_EQ(runTool("'" + out.string() + "' --frames 5 --width 160 --height 120 --noise off"), 0);
+
+  const auto rgb = readRows(out / "rgb.txt");
+  const auto depth = readRows(out / "depth.txt");
+  const auto assoc = readRows(out / "associations.txt");
+  const auto gt = readRows(out / "groundtruth.txt");
+  ASSERT_EQ(rgb.size(), 5u);
+  ASSERT_EQ(depth.size(), 5u);
+  ASSERT_EQ(assoc.size(), 5u);
+  ASSERT_EQ(gt.size(), 5u);
+  EXPECT_EQ(std::distance(fs::directory_iterator(out / "rgb"), fs::directory_iterator()), 5);
+  EXPECT_EQ(std::distance(fs::directory_iterator(out / "depth"), fs::directory_iterator()), 5);
+
+  const Camera camera = loadCameraYaml((out / "camera.yaml").string());
+  const Camera expected = scaledDefaultCamera(160, 120);
+  EXPECT_EQ(camera.width, 160);
+  EXPECT_EQ(camera.height, 120);
+  EXPECT_DOUBLE_EQ(camera.fx, expected.fx);
+  EXPECT_DOUBLE_EQ(camera.fy, expected.fy);
+  EXPECT_DOUBLE_EQ(camera.cx, expected.cx);
+  EXPECT_DOUBLE_EQ(camera.cy, expected.cy);
+  EXPECT_DOUBLE_EQ(camera.depth_scale, 5000.0);
+
+  // The same frames, in memory, to compare the files with.
+  SequenceOptions options;
+  options.frames = 5;
+  options.noise = false;
+  options.camera = expected;
+  const SynthSequence sequence(options);
+
+  char stamp[32];
+  for (int i = 0; i < 5; ++i) {
+    std::snprintf(stamp, sizeof stamp, "%.6f", 1000.0 + i / 30.0);
+    ASSERT_EQ(rgb[i].size(), 2u);
+    ASSERT_EQ(depth[i].size(), 2u);
+    ASSERT_EQ(assoc[i].size(), 4u);
+    ASSERT_EQ(gt[i].size(), 8u);
+    EXPECT_EQ(rgb[i][0], stamp);
+    EXPECT_EQ(rgb[i][1], std::string("rgb/") + stamp + ".png");
+    EXPECT_EQ(depth[i][0], stamp);
+    EXPECT_EQ(depth[i][1], std::string("depth/") + stamp + ".png");
+    EXPECT_EQ(assoc[i], (std::vector<std::string>{rgb[i][0], rgb[i][1], depth[i][0], depth[i][1]}));
+    EXPECT_EQ(gt[i][0], stamp);
+
+    const cv::Mat colour = cv::imread((out / rgb[i][1]).string(), cv::IMREAD_UNCHANGED);
+    const cv::Mat raw = cv::imread((out / depth[i][1]).string(), cv::IMREAD_UNCHANGED);
+    ASSERT_EQ(colour.type(), CV_8UC3);
+    ASSERT_EQ(raw.type(), CV_16UC1);
+    ASSERT_EQ(colour.size(), cv::Size(160, 120));
+    ASSERT_EQ(raw.size(), cv::Size(160, 120));
+
+    const SynthFrame f = sequence.frame(i);
+    EXPECT_EQ(cv::norm(colour, f.bgr, cv::NORM_INF), 0.0);
+    cv::Mat metres;
+    raw.convertTo(metres, CV_32F, 1.0 / 5000.0);
+    EXPECT_LE(cv::norm(metres, f.depth_m, cv::NORM_INF), 0.5 / 5000.0 + 1e-6);  // PNG step only
+
+    // Groundtruth: the exact pose, unit quaternion.
+    const Eigen::Vector3d t(std::stod(gt[i][1]), std::stod(gt[i][2]), std::stod(gt[i][3]));
+    const Eigen::Quaterniond q(std::stod(gt[i][7]), std::stod(gt[i][4]), std::stod(gt[i][5]),
+                               std::stod(gt[i][6]));
+    EXPECT_NEAR(q.norm(), 1.0, 1e-15);
+    EXPECT_GE(q.w(), 0.0);
+    EXPECT_LT((t - f.pose.translation()).norm(), 1e-15);
+    EXPECT_LT((q.toRotationMatrix() - f.pose.linear()).norm(), 1e-14);
+  }
+  EXPECT_LT(
+      (Eigen::Vector3d(std::stod(gt[0][1]), std::stod(gt[0][2]), std::stod(gt[0][3])) - kStartEye)
+          .norm(),
+      1e-15);
+}
+
+TEST(SynthTool, SameSeedSameFilesOtherSeedOtherImages) {
+  const fs::path a = test::tempDir("synth_tool_a"), b = test::tempDir("synth_tool_b"),
+                 c = test::tempDir("synth_tool_c");
+  const std::string common = " --frames 3 --width 96 --height 72 --blur on";
+  ASSERT_EQ(runTool("'" + a.string() + "'" + common + " --seed 4"), 0);
+  ASSERT_EQ(runTool("'" + b.string() + "'" + common + " --seed 4"), 0);
+  ASSERT_EQ(runTool("'" + c.string() + "'" + common + " --seed 5"), 0);
+  int files = 0;
+  for (const auto& entry : fs::recursive_directory_iterator(a)) {
+    if (!entry.is_regular_file()) continue;
+    const fs::path relative = fs::relative(entry.path(), a);
+    EXPECT_EQ(readBytes(entry.path()), readBytes(b / relative)) << relative;
+    ++files;
+  }
+  EXPECT_EQ(files, 3 + 3 + 5);  // images, depth images, 4 lists and camera.yaml
+  const std::string first = "rgb/1000.000000.png";
+  EXPECT_NE(readBytes(a / first), readBytes(c / first));
+  EXPECT_NE(readBytes(a / "groundtruth.txt"), readBytes(c / "groundtruth.txt"));
+}
+
+TEST(SynthTool, HelpAndBadOptions) {
+  EXPECT_EQ(runTool("--help"), 0);
+  const std::string out = "'" + test::tempDir("synth_tool_bad").string() + "'";
+  EXPECT_EQ(runTool(""), 2);                     // no output folder
+  EXPECT_EQ(runTool(out + " " + out), 2);        // two output folders
+  EXPECT_EQ(runTool(out + " --frames"), 2);      // missing value
+  EXPECT_EQ(runTool(out + " --frames ten"), 2);  // not a number
+  EXPECT_EQ(runTool(out + " --frames 0"), 2);    // out of range
+  EXPECT_EQ(runTool(out + " --rate -30"), 2);
+  EXPECT_EQ(runTool(out + " --speed -1"), 2);
+  EXPECT_EQ(runTool(out + " --motion spiral"), 2);
+  EXPECT_EQ(runTool(out + " --noise maybe"), 2);
+  EXPECT_EQ(runTool(out + " --width 4"), 2);
+  EXPECT_EQ(runTool(out + " --colour red"), 2);  // unknown option
+  EXPECT_FALSE(fs::exists(test::tempDir("synth_tool_bad") / "rgb.txt"));
+  // A folder that cannot be created is a run-time failure, not a usage error.
+  EXPECT_EQ(runTool("/proc/acvo_synth_cannot_write --frames 1 --width 16 --height 12"), 1);
+}
+
+}  // namespace
+}  // namespace acvo::synth
