@@ -4,9 +4,9 @@
 #include <cstring>
 #include <stdexcept>
 
-#include <opencv2/imgproc.hpp>
 #include <sensor_msgs/image_encodings.h>
 #include <tf2_eigen/tf2_eigen.h>
+#include <opencv2/imgproc.hpp>
 
 #include "acvo/depth.hpp"
 
@@ -68,8 +68,8 @@ ColorImage decodeColor(const sensor_msgs::Image& msg) {
   ColorImage out;
   const std::string& e = msg.encoding;
   if (e != enc::RGB8 && e != enc::BGR8 && e != enc::RGBA8 && e != enc::BGRA8 && e != enc::MONO8) {
-    out.problem = "unsupported colour encoding '" + e +
-                  "' (expected rgb8, bgr8, rgba8, bgra8 or mono8)";
+    out.problem =
+        "unsupported colour encoding '" + e + "' (expected rgb8, bgr8, rgba8, bgra8 or mono8)";
     return out;
   }
   out.problem = layoutProblem(msg);
@@ -83,7 +83,7 @@ ColorImage decodeColor(const sensor_msgs::Image& msg) {
   } else {
     out.image = view(msg, CV_8UC1).clone();
   }
-  out.order = (e == enc::MONO8)                   ? acvo::ColorOrder::kGray
+  out.order = (e == enc::MONO8)                     ? acvo::ColorOrder::kGray
               : (e == enc::RGB8 || e == enc::RGBA8) ? acvo::ColorOrder::kRgb
                                                     : acvo::ColorOrder::kBgr;
   return out;
@@ -187,7 +187,9 @@ Twist twistOf(const Eigen::Isometry3d& delta, double dt) {
   return out;
 }
 
-geometry_msgs::Pose toPoseMsg(const Eigen::Isometry3d& pose) { return tf2::toMsg(pose); }
+geometry_msgs::Pose toPoseMsg(const Eigen::Isometry3d& pose) {
+  return tf2::toMsg(pose);
+}
 
 Eigen::Isometry3d fromPoseMsg(const geometry_msgs::Pose& pose, std::string* problem) {
   const auto& q = pose.orientation;
@@ -207,8 +209,8 @@ Eigen::Isometry3d fromPoseMsg(const geometry_msgs::Pose& pose, std::string* prob
 }
 
 geometry_msgs::TransformStamped toTransformMsg(const Eigen::Isometry3d& pose,
-                                               const std::string& parent,
-                                               const std::string& child, const ros::Time& stamp) {
+                                               const std::string& parent, const std::string& child,
+                                               const ros::Time& stamp) {
   geometry_msgs::TransformStamped t = tf2::eigenToTransform(pose);
   t.header.stamp = stamp;
   t.header.frame_id = parent;
@@ -242,10 +244,10 @@ sensor_msgs::PointCloud2 toPointCloud2(const acvo::LabelledCloud& cloud,
     xyzc[0] = cloud.points[i].x();
     xyzc[1] = cloud.points[i].y();
     xyzc[2] = cloud.points[i].z();
-    const std::uint32_t packed =
-        has_rgb ? (std::uint32_t{cloud.rgb[i][0]} << 16) | (std::uint32_t{cloud.rgb[i][1]} << 8) |
-                      std::uint32_t{cloud.rgb[i][2]}
-                : 0x808080u;
+    const std::uint32_t packed = has_rgb ? (std::uint32_t{cloud.rgb[i][0]} << 16) |
+                                               (std::uint32_t{cloud.rgb[i][1]} << 8) |
+                                               std::uint32_t{cloud.rgb[i][2]}
+                                         : 0x808080u;
     std::memcpy(&xyzc[3], &packed, 4);
     std::memcpy(&msg.data[i * msg.point_step], xyzc, sizeof xyzc);
   }

@@ -5,14 +5,14 @@
 
 #include <string>
 
-#include <Eigen/Geometry>
 #include <geometry_msgs/Pose.h>
 #include <geometry_msgs/TransformStamped.h>
-#include <opencv2/core.hpp>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <std_msgs/Header.h>
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
 
 #include "acvo/camera.hpp"
 #include "acvo/frame.hpp"
@@ -36,7 +36,7 @@ struct ColorImage {
 ColorImage decodeColor(const sensor_msgs::Image& msg);
 
 struct DepthImage {
-  cv::Mat metres;  // CV_32FC1, 0 = invalid
+  cv::Mat metres;                // CV_32FC1, 0 = invalid
   double units_per_metre = 1.0;  // 1000 for 16UC1 millimetres, 1 for 32FC1 metres
   std::string problem;
 };
@@ -82,8 +82,8 @@ geometry_msgs::Pose toPoseMsg(const Eigen::Isometry3d& pose);
 Eigen::Isometry3d fromPoseMsg(const geometry_msgs::Pose& pose, std::string* problem);
 
 geometry_msgs::TransformStamped toTransformMsg(const Eigen::Isometry3d& pose,
-                                               const std::string& parent,
-                                               const std::string& child, const ros::Time& stamp);
+                                               const std::string& parent, const std::string& child,
+                                               const ros::Time& stamp);
 
 // xyz (float32) + rgb (float32 holding 0x00RRGGBB, as rviz and PCL expect), unorganised, in the
 // camera frame of `header`.

@@ -2,9 +2,13 @@
 
 namespace acvo_ros {
 
-Covariance6 originCovariance() { return Covariance6::Identity() * kOriginVariance; }
+Covariance6 originCovariance() {
+  return Covariance6::Identity() * kOriginVariance;
+}
 
-Covariance6 lostCovariance() { return Covariance6::Identity() * kLostVariance; }
+Covariance6 lostCovariance() {
+  return Covariance6::Identity() * kLostVariance;
+}
 
 Covariance6 toRosOrder(const Covariance6& rotation_first) {
   // Permutation that swaps the two 3-blocks: P = [0 I; I 0], P C P^T.

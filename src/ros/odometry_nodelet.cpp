@@ -10,8 +10,6 @@
 #include <optional>
 #include <string>
 
-#include <boost/bind/bind.hpp>
-#include <boost/thread/recursive_mutex.hpp>
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <dynamic_reconfigure/server.h>
 #include <image_transport/image_transport.h>
@@ -22,13 +20,15 @@
 #include <message_filters/synchronizer.h>
 #include <nav_msgs/Odometry.h>
 #include <nodelet/nodelet.h>
-#include <pluginlib/class_list_macros.hpp>
 #include <ros/ros.h>
 #include <std_srvs/Empty.h>
 #include <tf2_eigen/tf2_eigen.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
+#include <boost/bind/bind.hpp>
+#include <boost/thread/recursive_mutex.hpp>
+#include <pluginlib/class_list_macros.hpp>
 
 #include "acvo/AcvoConfig.h"
 #include "acvo/OdometryInfo.h"
@@ -75,8 +75,7 @@ class OdometryNodelet : public nodelet::Nodelet {
   std::string baseFrame() const;
   std::optional<Eigen::Isometry3d> baseFromCamera();
   void publish(const acvo::OdometryResult& r, const std_msgs::Header& header, double dt);
-  void publishInfo(const acvo::OdometryResult& r, const std_msgs::Header& header,
-                   double ms_total);
+  void publishInfo(const acvo::OdometryResult& r, const std_msgs::Header& header, double ms_total);
   void rejectFrame(const std_msgs::Header& header, const std::string& why, double ms_total);
   void restart(const Eigen::Isometry3d& camera_pose);
 
@@ -117,13 +116,13 @@ class OdometryNodelet : public nodelet::Nodelet {
   std::mutex mutex_;
   acvo::Params params_;
   std::unique_ptr<acvo::Odometry> odometry_;
-  Covariance6 pose_covariance_ = originCovariance();  // ROS order, camera-0 axes
-  std::string camera_frame_;                         // optical frame of the last image
+  Covariance6 pose_covariance_ = originCovariance();   // ROS order, camera-0 axes
+  std::string camera_frame_;                           // optical frame of the last image
   std::optional<Eigen::Isometry3d> base_from_camera_;  // looked up once per camera frame
-  ros::Time last_stamp_;                             // stamp of the last frame processed
+  ros::Time last_stamp_;                               // stamp of the last frame processed
   std::uint32_t lost_count_ = 0;
-  std::uint64_t frames_ = 0;      // frames given to the odometry
-  bool synchronised_ = false;     // a frame came out of the synchroniser
+  std::uint64_t frames_ = 0;   // frames given to the odometry
+  bool synchronised_ = false;  // a frame came out of the synchroniser
   acvo::Tracking last_tracking_ = acvo::Tracking::kFirstFrame;
   std::string last_message_;
   double last_ms_total_ = 0.0;
@@ -409,8 +408,7 @@ std::optional<Eigen::Isometry3d> OdometryNodelet::baseFromCamera() {
     if (tf_buffer_->canTransform(base, camera_frame_, ros::Time(0), &error)) {
       base_from_camera_ =
           tf2::transformToEigen(tf_buffer_->lookupTransform(base, camera_frame_, ros::Time(0)));
-      NODELET_INFO("camera '%s' in base '%s': looked up once", camera_frame_.c_str(),
-                   base.c_str());
+      NODELET_INFO("camera '%s' in base '%s': looked up once", camera_frame_.c_str(), base.c_str());
       return base_from_camera_;
     }
     if (ros::WallTime::now() >= deadline) break;

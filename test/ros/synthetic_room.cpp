@@ -50,6 +50,8 @@ Eigen::Isometry3d cameraPose(int k) {
   return pose;
 }
 
-Eigen::Isometry3d worldFromFirstCamera() { return acvo::synth::defaultStartPose(); }
+Eigen::Isometry3d worldFromFirstCamera() {
+  return acvo::synth::defaultStartPose();
+}
 
 }  // namespace acvo_test

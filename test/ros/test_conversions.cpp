@@ -282,7 +282,8 @@ TEST(RosParams, ReadsEverySectionWithCoreNamesAndReportsProblems) {
   XmlRpc::XmlRpcValue ns;
   ns["selection"] = section("target_points", 1234);
   ns["selection"]["max_depth"] = 4;  // an integer is fine for a double
-  ns["solver"] = section("ell_policy", std::string(acvo::toString(acvo::EllPolicy::kFixedSchedule)));
+  ns["solver"] =
+      section("ell_policy", std::string(acvo::toString(acvo::EllPolicy::kFixedSchedule)));
   ns["solver"]["max_iterations"] = 2.5;  // wrong type: reported, default kept
   ns["solver"]["no_such_key"] = 1;
   ns["odometry"] = section("initial_guess", std::string("sideways"));

@@ -1,13 +1,15 @@
 // Builds the camera messages of a synthetic frame in the encodings a driver would send.
 #pragma once
 
+#include <limits>
+#include <stdexcept>
 #include <string>
 
 #include <cv_bridge/cv_bridge.h>
-#include <opencv2/imgproc.hpp>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/image_encodings.h>
+#include <opencv2/imgproc.hpp>
 
 #include "acvo/camera.hpp"
 
@@ -18,12 +20,18 @@ inline sensor_msgs::ImagePtr colorMsg(const cv::Mat& rgb, const std::string& enc
                                       const std_msgs::Header& header) {
   namespace enc = sensor_msgs::image_encodings;
   cv::Mat out;
-  if (encoding == enc::RGB8) out = rgb;
-  else if (encoding == enc::BGR8) cv::cvtColor(rgb, out, cv::COLOR_RGB2BGR);
-  else if (encoding == enc::RGBA8) cv::cvtColor(rgb, out, cv::COLOR_RGB2RGBA);
-  else if (encoding == enc::BGRA8) cv::cvtColor(rgb, out, cv::COLOR_RGB2BGRA);
-  else if (encoding == enc::MONO8) cv::cvtColor(rgb, out, cv::COLOR_RGB2GRAY);
-  else throw std::invalid_argument("colorMsg: encoding " + encoding);
+  if (encoding == enc::RGB8)
+    out = rgb;
+  else if (encoding == enc::BGR8)
+    cv::cvtColor(rgb, out, cv::COLOR_RGB2BGR);
+  else if (encoding == enc::RGBA8)
+    cv::cvtColor(rgb, out, cv::COLOR_RGB2RGBA);
+  else if (encoding == enc::BGRA8)
+    cv::cvtColor(rgb, out, cv::COLOR_RGB2BGRA);
+  else if (encoding == enc::MONO8)
+    cv::cvtColor(rgb, out, cv::COLOR_RGB2GRAY);
+  else
+    throw std::invalid_argument("colorMsg: encoding " + encoding);
   return cv_bridge::CvImage(header, encoding, out).toImageMsg();
 }
 
