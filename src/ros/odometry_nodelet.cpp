@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <limits>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -31,11 +30,11 @@
 #include <pluginlib/class_list_macros.hpp>
 
 #include "acvo/AcvoConfig.h"
-#include "acvo/OdometryInfo.h"
 #include "acvo/ResetToPose.h"
 #include "acvo/odometry.hpp"
 #include "conversions.hpp"
 #include "covariance.hpp"
+#include "messages.hpp"
 #include "ros_params.hpp"
 #include "stamp_check.hpp"
 
@@ -426,30 +425,16 @@ void OdometryNodelet::publish(const acvo::OdometryResult& r, const std_msgs::Hea
   const std::optional<Eigen::Isometry3d> base_from_camera = baseFromCamera();
   if (!base_from_camera) return;
   const std::string base = baseFrame();
-  const Eigen::Matrix3d rot = base_from_camera->rotation();
-  const bool lost = r.tracking == acvo::Tracking::kLost;
-
-  if (!(lost && publish_null_when_lost_)) {
-    nav_msgs::Odometry odom;
-    odom.header.stamp = header.stamp;
-    odom.header.frame_id = odom_frame_;
-    odom.child_frame_id = base;
-    const Eigen::Isometry3d pose = conjugate(*base_from_camera, r.pose);
-    odom.pose.pose = toPoseMsg(pose);
-    const auto pose_cov = toArray(rotate(pose_covariance_, rot));
-    std::copy(pose_cov.begin(), pose_cov.end(), odom.pose.covariance.begin());
-    Covariance6 twist_cov = lostCovariance();  // first frame and lost: velocity unknown
-    if (!lost && r.tracking != acvo::Tracking::kFirstFrame && dt > 0.0) {
-      const Twist twist = twistOf(conjugate(*base_from_camera, r.motion), dt);
-      odom.twist.twist.linear = tf2::toMsg(twist.linear, odom.twist.twist.linear);
-      odom.twist.twist.angular = tf2::toMsg(twist.angular, odom.twist.twist.angular);
-      twist_cov = rotate(toRosOrder(sanitise(r.motion_covariance)), rot) / (dt * dt);
-    }
-    const auto twist_arr = toArray(twist_cov);
-    std::copy(twist_arr.begin(), twist_arr.end(), odom.twist.covariance.begin());
+  if (!(r.tracking == acvo::Tracking::kLost && publish_null_when_lost_)) {
+    std_msgs::Header odom_header;
+    odom_header.stamp = header.stamp;
+    odom_header.frame_id = odom_frame_;
+    const nav_msgs::Odometry odom =
+        toOdometryMsg(r, *base_from_camera, pose_covariance_, dt, odom_header, base);
     odom_pub_.publish(odom);
     if (publish_tf_) {
-      tf_broadcaster_->sendTransform(toTransformMsg(pose, odom_frame_, base, header.stamp));
+      tf_broadcaster_->sendTransform(
+          toTransformMsg(conjugate(*base_from_camera, r.pose), odom_frame_, base, header.stamp));
     }
   }
   const acvo::LabelledCloud* cloud = odometry_->lastCloud();
@@ -463,24 +448,7 @@ void OdometryNodelet::publish(const acvo::OdometryResult& r, const std_msgs::Hea
 void OdometryNodelet::publishInfo(const acvo::OdometryResult& r, const std_msgs::Header& header,
                                   double ms_total) {
   last_ms_total_ = ms_total;
-  acvo::OdometryInfo info;
-  info.header = header;
-  info.lost = r.tracking == acvo::Tracking::kLost;
-  info.tracking = acvo::toString(r.tracking);
-  info.status = acvo::toString(r.solver.status);
-  info.iterations = r.solver.iterations;
-  info.ell = r.solver.ell;
-  info.ell_at_bound = r.solver.ell_at_bound;
-  info.fixed_points = static_cast<std::uint32_t>(r.fixed_points);
-  info.moving_points = static_cast<std::uint32_t>(r.moving_points);
-  info.nnz = r.solver.nnz;
-  info.inner_product = r.solver.inner_product;
-  info.ms_cloud = r.ms_cloud;
-  info.ms_registration = r.ms_registration;
-  info.ms_total = ms_total;
-  info.lost_count = lost_count_;
-  info.message = r.message;
-  info_pub_.publish(info);
+  info_pub_.publish(toInfoMsg(r, header, ms_total, lost_count_));
 }
 
 void OdometryNodelet::restart(const Eigen::Isometry3d& camera_pose) {
@@ -584,28 +552,11 @@ void OdometryNodelet::onWatchdog(const ros::WallTimerEvent&) {
 }
 
 void OdometryNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
-  using diagnostic_msgs::DiagnosticStatus;
   std::lock_guard<std::mutex> lock(mutex_);
   const double silent = (ros::WallTime::now() - last_frame_wall_).toSec();
-  if (!synchronised_ || silent > no_data_timeout_) {
-    stat.summary(DiagnosticStatus::ERROR, "no data");
-  } else {
-    switch (last_tracking_) {
-      case acvo::Tracking::kOk:
-      case acvo::Tracking::kFirstFrame:
-        stat.summary(DiagnosticStatus::OK, "tracking");
-        break;
-      case acvo::Tracking::kHard:
-        stat.summary(DiagnosticStatus::WARN, "hard to track");
-        break;
-      case acvo::Tracking::kLost:
-        stat.summary(DiagnosticStatus::ERROR, "lost");
-        break;
-      case acvo::Tracking::kBadFrame:
-        stat.summary(DiagnosticStatus::ERROR, "bad input");
-        break;
-    }
-  }
+  const DiagnosticSummary summary =
+      summarise(synchronised_, silent, no_data_timeout_, last_tracking_);
+  stat.summary(summary.level, summary.message);
   stat.add("seconds since last frame", silent);
   stat.add("frames processed", frames_);
   stat.add("frames lost", lost_count_);

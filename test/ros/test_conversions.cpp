@@ -3,11 +3,13 @@
 #include <cmath>
 #include <cstring>
 
+#include <diagnostic_msgs/DiagnosticStatus.h>
 #include <gtest/gtest.h>
 #include <sensor_msgs/image_encodings.h>
 
 #include "conversions.hpp"
 #include "covariance.hpp"
+#include "messages.hpp"
 #include "ros_params.hpp"
 #include "stamp_check.hpp"
 
@@ -338,6 +340,90 @@ TEST(RosParams, EveryReconfigureEnumValueIsAcceptedByTheCore) {
     acvo::InitialGuess v;
     EXPECT_NO_THROW(acvo::fromString(name, v)) << name;
   }
+}
+
+acvo::OdometryResult registered(const Eigen::Isometry3d& pose, const Eigen::Isometry3d& motion) {
+  acvo::OdometryResult r;
+  r.tracking = acvo::Tracking::kOk;
+  r.pose = pose;
+  r.motion = motion;
+  r.motion_covariance = Covariance6::Identity() * 1e-6;
+  r.motion_covariance(0, 0) = 4e-6;  // rotation about the camera's x
+  return r;
+}
+
+TEST(OdometryMsg, PoseTwistAndCovariancesAreInTheBaseFrame) {
+  Eigen::Isometry3d base_from_optical = Eigen::Isometry3d::Identity();
+  base_from_optical.linear() << 0, 0, 1, -1, 0, 0, 0, -1, 0;  // REP 103 optical frame
+  Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
+  step.translation() << 0, 0, 0.02;  // 2 cm along the optical axis
+  std_msgs::Header h;
+  h.frame_id = "odom";
+  Covariance6 pose_cov = Covariance6::Zero();
+  pose_cov(0, 0) = 1e-4;  // along the first camera's x (the base's -y)
+  const nav_msgs::Odometry m =
+      toOdometryMsg(registered(step, step), base_from_optical, pose_cov, 0.1, h, "base_link");
+  EXPECT_EQ(m.header.frame_id, "odom");
+  EXPECT_EQ(m.child_frame_id, "base_link");
+  EXPECT_NEAR(m.pose.pose.position.x, 0.02, 1e-12);  // forward is the base's x
+  EXPECT_NEAR(m.pose.pose.position.y, 0.0, 1e-12);
+  EXPECT_NEAR(m.twist.twist.linear.x, 0.2, 1e-12);
+  EXPECT_NEAR(m.pose.covariance[7], 1e-4, 1e-15);  // y y
+  EXPECT_NEAR(m.pose.covariance[0], 0.0, 1e-15);
+  // Rotation about the camera's x is rotation about the base's -y: twist roll-pitch-yaw order.
+  EXPECT_NEAR(m.twist.covariance[4 * 6 + 4], 4e-6 / 0.01, 1e-12);
+  EXPECT_NEAR(m.twist.covariance[0], 1e-6 / 0.01, 1e-12);
+}
+
+TEST(OdometryMsg, VelocityIsUnknownOnFirstAndLostFrames) {
+  for (acvo::Tracking t : {acvo::Tracking::kFirstFrame, acvo::Tracking::kLost}) {
+    acvo::OdometryResult r =
+        registered(Eigen::Isometry3d::Identity(), Eigen::Isometry3d::Identity());
+    r.tracking = t;
+    const nav_msgs::Odometry m =
+        toOdometryMsg(r, Eigen::Isometry3d::Identity(), originCovariance(), 0.1, {}, "cam");
+    EXPECT_EQ(m.twist.twist.linear.x, 0.0);
+    for (int d = 0; d < 6; ++d) EXPECT_EQ(m.twist.covariance[7 * d], kLostVariance);
+  }
+  // dt = 0 (no previous stamp) too.
+  const nav_msgs::Odometry m =
+      toOdometryMsg(registered(Eigen::Isometry3d::Identity(), Eigen::Isometry3d::Identity()),
+                    Eigen::Isometry3d::Identity(), originCovariance(), 0.0, {}, "cam");
+  EXPECT_EQ(m.twist.covariance[0], kLostVariance);
+}
+
+TEST(InfoMsg, CarriesTheResult) {
+  acvo::OdometryResult r;
+  r.tracking = acvo::Tracking::kLost;
+  r.message = "too few points";
+  r.solver.iterations = 17;
+  r.solver.ell = 0.05;
+  r.fixed_points = 1200;
+  r.moving_points = 30;
+  const acvo::OdometryInfo info = toInfoMsg(r, {}, 12.5, 3);
+  EXPECT_TRUE(info.lost);
+  EXPECT_EQ(info.tracking, acvo::toString(acvo::Tracking::kLost));
+  EXPECT_EQ(info.iterations, 17);
+  EXPECT_EQ(info.ell, 0.05);
+  EXPECT_EQ(info.fixed_points, 1200u);
+  EXPECT_EQ(info.moving_points, 30u);
+  EXPECT_EQ(info.ms_total, 12.5);
+  EXPECT_EQ(info.lost_count, 3u);
+  EXPECT_EQ(info.message, "too few points");
+}
+
+TEST(Diagnostics, NoDataFirstThenTheLastFramesJudgement) {
+  using diagnostic_msgs::DiagnosticStatus;
+  EXPECT_EQ(summarise(false, 0.0, 3.0, acvo::Tracking::kOk).message, "no data");
+  EXPECT_EQ(summarise(true, 3.5, 3.0, acvo::Tracking::kOk).message, "no data");
+  EXPECT_EQ(summarise(true, 3.5, 3.0, acvo::Tracking::kOk).level, DiagnosticStatus::ERROR);
+  EXPECT_EQ(summarise(true, 0.1, 3.0, acvo::Tracking::kFirstFrame).level, DiagnosticStatus::OK);
+  const DiagnosticSummary hard = summarise(true, 0.1, 3.0, acvo::Tracking::kHard);
+  EXPECT_EQ(hard.level, DiagnosticStatus::WARN);
+  EXPECT_EQ(hard.message, "hard to track");
+  EXPECT_EQ(summarise(true, 0.1, 3.0, acvo::Tracking::kLost).message, "lost");
+  EXPECT_EQ(summarise(true, 0.1, 3.0, acvo::Tracking::kBadFrame).message, "bad input");
+  EXPECT_EQ(summarise(true, 0.1, 3.0, acvo::Tracking::kBadFrame).level, DiagnosticStatus::ERROR);
 }
 
 }  // namespace

@@ -1,0 +1,80 @@
+#include "messages.hpp"
+
+#include <algorithm>
+
+#include <diagnostic_msgs/DiagnosticStatus.h>
+#include <tf2_eigen/tf2_eigen.h>
+
+#include "conversions.hpp"
+
+namespace acvo_ros {
+
+nav_msgs::Odometry toOdometryMsg(const acvo::OdometryResult& result,
+                                 const Eigen::Isometry3d& base_from_camera,
+                                 const Covariance6& pose_covariance, double dt,
+                                 const std_msgs::Header& header, const std::string& child) {
+  const Eigen::Matrix3d rot = base_from_camera.rotation();
+  nav_msgs::Odometry odom;
+  odom.header = header;
+  odom.child_frame_id = child;
+  odom.pose.pose = toPoseMsg(conjugate(base_from_camera, result.pose));
+  const auto pose_cov = toArray(rotate(pose_covariance, rot));
+  std::copy(pose_cov.begin(), pose_cov.end(), odom.pose.covariance.begin());
+
+  Covariance6 twist_cov = lostCovariance();
+  const bool registered =
+      result.tracking == acvo::Tracking::kOk || result.tracking == acvo::Tracking::kHard;
+  if (registered && dt > 0.0) {
+    const Twist twist = twistOf(conjugate(base_from_camera, result.motion), dt);
+    tf2::toMsg(twist.linear, odom.twist.twist.linear);
+    tf2::toMsg(twist.angular, odom.twist.twist.angular);
+    twist_cov = rotate(toRosOrder(sanitise(result.motion_covariance)), rot) / (dt * dt);
+  }
+  const auto twist_arr = toArray(twist_cov);
+  std::copy(twist_arr.begin(), twist_arr.end(), odom.twist.covariance.begin());
+  return odom;
+}
+
+acvo::OdometryInfo toInfoMsg(const acvo::OdometryResult& result, const std_msgs::Header& header,
+                             double ms_total, std::uint32_t lost_count) {
+  acvo::OdometryInfo info;
+  info.header = header;
+  info.lost = result.tracking == acvo::Tracking::kLost;
+  info.tracking = acvo::toString(result.tracking);
+  info.status = acvo::toString(result.solver.status);
+  info.iterations = result.solver.iterations;
+  info.ell = result.solver.ell;
+  info.ell_at_bound = result.solver.ell_at_bound;
+  info.fixed_points = static_cast<std::uint32_t>(result.fixed_points);
+  info.moving_points = static_cast<std::uint32_t>(result.moving_points);
+  info.nnz = result.solver.nnz;
+  info.inner_product = result.solver.inner_product;
+  info.ms_cloud = result.ms_cloud;
+  info.ms_registration = result.ms_registration;
+  info.ms_total = ms_total;
+  info.lost_count = lost_count;
+  info.message = result.message;
+  return info;
+}
+
+DiagnosticSummary summarise(bool synchronised, double seconds_since_frame, double no_data_timeout,
+                            acvo::Tracking last) {
+  using diagnostic_msgs::DiagnosticStatus;
+  if (!synchronised || seconds_since_frame > no_data_timeout) {
+    return {DiagnosticStatus::ERROR, "no data"};
+  }
+  switch (last) {
+    case acvo::Tracking::kOk:
+    case acvo::Tracking::kFirstFrame:
+      return {DiagnosticStatus::OK, "tracking"};
+    case acvo::Tracking::kHard:
+      return {DiagnosticStatus::WARN, "hard to track"};
+    case acvo::Tracking::kLost:
+      return {DiagnosticStatus::ERROR, "lost"};
+    case acvo::Tracking::kBadFrame:
+      break;
+  }
+  return {DiagnosticStatus::ERROR, "bad input"};
+}
+
+}  // namespace acvo_ros

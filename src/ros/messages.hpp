@@ -1,0 +1,42 @@
+// The nodelet's outgoing messages built from an odometry result: nav_msgs/Odometry for a base
+// frame rigidly attached to the camera, the per-frame OdometryInfo, and the diagnostic summary.
+// Values in, messages out; publishing stays in the nodelet.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include <nav_msgs/Odometry.h>
+#include <std_msgs/Header.h>
+#include <Eigen/Geometry>
+
+#include "acvo/OdometryInfo.h"
+#include "acvo/odometry.hpp"
+#include "covariance.hpp"
+
+namespace acvo_ros {
+
+// `header`: stamp and odometry frame; `child`: the base frame. The pose is the camera pose
+// conjugated by `base_from_camera`; `pose_covariance` (ROS order, first camera's axes) is
+// rotated into the base axes. The twist is the conjugated relative motion over `dt`, in the
+// base frame, with covariance motion_covariance / dt^2; it is zero with lostCovariance() for a
+// first frame, a lost frame or dt <= 0 (velocity unknown).
+nav_msgs::Odometry toOdometryMsg(const acvo::OdometryResult& result,
+                                 const Eigen::Isometry3d& base_from_camera,
+                                 const Covariance6& pose_covariance, double dt,
+                                 const std_msgs::Header& header, const std::string& child);
+
+acvo::OdometryInfo toInfoMsg(const acvo::OdometryResult& result, const std_msgs::Header& header,
+                             double ms_total, std::uint32_t lost_count);
+
+// What diagnostics say: "no data" (ERROR) when nothing was synchronised yet or for longer than
+// `no_data_timeout` s; otherwise from the last frame: OK "tracking" (ok, first frame), WARN
+// "hard to track", ERROR "lost", ERROR "bad input".
+struct DiagnosticSummary {
+  std::uint8_t level = 0;  // diagnostic_msgs::DiagnosticStatus level
+  std::string message;
+};
+DiagnosticSummary summarise(bool synchronised, double seconds_since_frame, double no_data_timeout,
+                            acvo::Tracking last);
+
+}  // namespace acvo_ros
