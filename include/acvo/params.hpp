@@ -27,7 +27,7 @@ struct SolverParams {
   double ell_step = 0.3;        // gamma_l, step of the length-scale update
   double ell_reduction = 0.7;   // lambda_l, factor applied to ell_max when ell reaches it
   double sigma = 0.1;           // spatial signal std
-  double color_ell = 0.5;       // colour length-scale (measured, see config/acvo.yaml)
+  double color_ell = 0.1;       // colour length-scale (paper 0.1; measured, see config/acvo.yaml)
   double color_sigma = 1.0;     // colour signal std
   double sparsification = 8.315e-3;  // a_ij below this are dropped
   double eps_transform = 1e-5;  // stop when t*|xi| < eps_transform
