@@ -49,6 +49,7 @@ struct OdometryParams {
   double hard_inner_product = 0.15;
   double max_translation = 0.3;   // m per frame
   double max_rotation = 20.0;     // deg per frame
+  int hard_ell_reductions = 3;    // hard to track when ell_max was reduced this often in a frame
   // Relative-motion covariance = covariance_scale * (-H)^-1, H the curvature of the objective at
   // the optimum; see odometry.hpp.
   double covariance_scale = 1.0;
@@ -101,6 +102,7 @@ void visitParams(Params_& p, Visitor&& visit) {
   visit("odometry", "hard_inner_product", p.odometry.hard_inner_product);
   visit("odometry", "max_translation", p.odometry.max_translation);
   visit("odometry", "max_rotation", p.odometry.max_rotation);
+  visit("odometry", "hard_ell_reductions", p.odometry.hard_ell_reductions);
   visit("odometry", "covariance_scale", p.odometry.covariance_scale);
 }
 

@@ -172,6 +172,7 @@ SolverResult align(const PreparedCloud& fixed, const PreparedCloud& moving,
         if (ell >= ell_max) {
           // ell_max never drops below ell_min: past that the bound would shrink forever.
           ell_max = std::max(ell_max * p.ell_reduction, p.ell_min);
+          ++result.ell_max_reductions;
           ell = ell_max;
         }
         ell = std::max(ell, p.ell_min);
