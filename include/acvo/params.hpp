@@ -37,6 +37,12 @@ struct SolverParams {
   double omega_scale = 7.0;     // c: omega = (1/c) sum a (x cross y)
   double v_scale = 7.0;         // d: v = (1/d) sum a (y - x)
   int max_iterations = 200;     // reference code: 2000 (too many for real time)
+  // Coarse stage (not in the paper): before the main iterations, a few CVO iterations with a
+  // wide fixed length-scale on a subset of the moving points widen the basin of convergence
+  // (a 5 degree rotation moves points 17 cm at 2 m, beyond the reach of ell_max). 0 = off.
+  double coarse_ell = 0.4;      // m
+  int coarse_points = 500;      // moving points used by the coarse stage (evenly strided)
+  int coarse_iterations = 20;   // iteration cap of the coarse stage
   int min_points = 30;          // fewer points in either cloud -> status too_few_points
 };
 
@@ -95,6 +101,9 @@ void visitParams(Params_& p, Visitor&& visit) {
   visit("solver", "omega_scale", p.solver.omega_scale);
   visit("solver", "v_scale", p.solver.v_scale);
   visit("solver", "max_iterations", p.solver.max_iterations);
+  visit("solver", "coarse_ell", p.solver.coarse_ell);
+  visit("solver", "coarse_points", p.solver.coarse_points);
+  visit("solver", "coarse_iterations", p.solver.coarse_iterations);
   visit("solver", "min_points", p.solver.min_points);
   visit("odometry", "initial_guess", p.odometry.initial_guess);
   visit("odometry", "threads", p.odometry.threads);

@@ -30,7 +30,8 @@ struct SolverResult {
   // Maps points of the moving (current) cloud into the fixed (previous) cloud's frame.
   Eigen::Isometry3d transform = Eigen::Isometry3d::Identity();
   SolverStatus status = SolverStatus::kTooFewPoints;
-  int iterations = 0;
+  int iterations = 0;          // main-stage iterations
+  int coarse_iterations = 0;   // coarse-stage iterations (SolverParams::coarse_ell)
   double ell = 0.0;            // final spatial length-scale
   bool ell_at_bound = false;   // final ell pinned at ell_min or at the (shrunk) ell_max
   int ell_bound_iterations = 0;  // iterations that ended with ell pinned at a bound
