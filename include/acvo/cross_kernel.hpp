@@ -40,7 +40,10 @@ SelfSums selfKernelSums(const PreparedCloud& cloud, double ell, const SolverPara
 
 class CrossKernel {
  public:
-  CrossKernel(const PreparedCloud& fixed, const PreparedCloud& moving, const SolverParams& params);
+  // `grid` indexes the fixed cloud's points; its cell must be at least the largest search
+  // radius used (default: the fixed cloud's own grid).
+  CrossKernel(const PreparedCloud& fixed, const PreparedCloud& moving, const SolverParams& params,
+              const VoxelGrid* grid = nullptr);
 
   // Finds the kept pairs at transform T and length-scale ell and accumulates their sums.
   // The pairs are kept for stepSums() and curvature() until the next call.
@@ -79,6 +82,7 @@ class CrossKernel {
 
   const PreparedCloud& fixed_;
   const PreparedCloud& moving_;
+  const VoxelGrid& grid_;
   SolverParams params_;
   double ell_ = 0.0;
   std::vector<Eigen::Vector3f> y_;  // transformed moving points

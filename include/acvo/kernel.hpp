@@ -61,6 +61,7 @@ struct SelfPair {
 struct PreparedCloud {
   LabelledCloud cloud;
   VoxelGrid grid;                 // cell = the search radius at the largest length-scale
+  VoxelGrid coarse_grid;          // cell = the search radius at the coarse stage's length-scale
   std::vector<SelfPair> self_pairs;  // all pairs within that radius that can pass the threshold
   // The same pairs' d2 and colour factors as arrays, for vectorised sums per iteration.
   Eigen::ArrayXf self_d2, self_color;
@@ -69,8 +70,10 @@ struct PreparedCloud {
   std::size_t size() const { return cloud.size(); }
 };
 
-// The largest spatial length-scale the solver may use with these parameters.
+// The largest spatial length-scale the solver's main stage may use with these parameters.
 double largestEll(const SolverParams& params);
+// Cell of a search grid serving radii up to that of length-scale `ell`.
+float gridCell(double ell, const SolverParams& params);
 
 PreparedCloud prepareCloud(LabelledCloud cloud, const SolverParams& params);
 

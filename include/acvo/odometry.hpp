@@ -45,7 +45,7 @@ struct OdometryResult {
 //    is kept, the motion prior is dropped and the reference is re-seeded from this frame (kept
 //    when this frame has too few points, so a blank frame does not erase a good reference).
 //  - hard: inner product below hard_inner_product, iteration cap reached, or the length-scale
-//    pinned at a bound at the end.
+//    reached its upper bound at least hard_ell_reductions times (each time the bound shrinks).
 //  - ok otherwise.
 class Odometry {
  public:

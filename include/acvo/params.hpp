@@ -27,7 +27,7 @@ struct SolverParams {
   double ell_step = 0.3;        // gamma_l, step of the length-scale update
   double ell_reduction = 0.7;   // lambda_l, factor applied to ell_max when ell reaches it
   double sigma = 0.1;           // spatial signal std
-  double color_ell = 0.5;       // colour length-scale (measured, see config/acvo.yaml)
+  double color_ell = 0.1;       // colour length-scale (paper 0.1; measured, see config/acvo.yaml)
   double color_sigma = 1.0;     // colour signal std
   double sparsification = 8.315e-3;  // a_ij below this are dropped
   double eps_transform = 1e-5;  // stop when t*|xi| < eps_transform
@@ -37,6 +37,12 @@ struct SolverParams {
   double omega_scale = 7.0;     // c: omega = (1/c) sum a (x cross y)
   double v_scale = 7.0;         // d: v = (1/d) sum a (y - x)
   int max_iterations = 200;     // reference code: 2000 (too many for real time)
+  // Coarse stage (not in the paper): before the main iterations, a few CVO iterations with a
+  // wide fixed length-scale on a subset of the moving points widen the basin of convergence
+  // (a 5 degree rotation moves points 17 cm at 2 m, beyond the reach of ell_max). 0 = off.
+  double coarse_ell = 0.4;      // m
+  int coarse_points = 500;      // moving points used by the coarse stage (evenly strided)
+  int coarse_iterations = 20;   // iteration cap of the coarse stage
   int min_points = 30;          // fewer points in either cloud -> status too_few_points
 };
 
@@ -49,6 +55,7 @@ struct OdometryParams {
   double hard_inner_product = 0.15;
   double max_translation = 0.3;   // m per frame
   double max_rotation = 20.0;     // deg per frame
+  int hard_ell_reductions = 3;    // hard to track when ell_max was reduced this often in a frame
   // Relative-motion covariance = covariance_scale * (-H)^-1, H the curvature of the objective at
   // the optimum; see odometry.hpp.
   double covariance_scale = 1.0;
@@ -94,6 +101,9 @@ void visitParams(Params_& p, Visitor&& visit) {
   visit("solver", "omega_scale", p.solver.omega_scale);
   visit("solver", "v_scale", p.solver.v_scale);
   visit("solver", "max_iterations", p.solver.max_iterations);
+  visit("solver", "coarse_ell", p.solver.coarse_ell);
+  visit("solver", "coarse_points", p.solver.coarse_points);
+  visit("solver", "coarse_iterations", p.solver.coarse_iterations);
   visit("solver", "min_points", p.solver.min_points);
   visit("odometry", "initial_guess", p.odometry.initial_guess);
   visit("odometry", "threads", p.odometry.threads);
@@ -101,6 +111,7 @@ void visitParams(Params_& p, Visitor&& visit) {
   visit("odometry", "hard_inner_product", p.odometry.hard_inner_product);
   visit("odometry", "max_translation", p.odometry.max_translation);
   visit("odometry", "max_rotation", p.odometry.max_rotation);
+  visit("odometry", "hard_ell_reductions", p.odometry.hard_ell_reductions);
   visit("odometry", "covariance_scale", p.odometry.covariance_scale);
 }
 

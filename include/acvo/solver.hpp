@@ -30,10 +30,14 @@ struct SolverResult {
   // Maps points of the moving (current) cloud into the fixed (previous) cloud's frame.
   Eigen::Isometry3d transform = Eigen::Isometry3d::Identity();
   SolverStatus status = SolverStatus::kTooFewPoints;
-  int iterations = 0;
+  int iterations = 0;          // main-stage iterations
+  int coarse_iterations = 0;   // coarse-stage iterations (SolverParams::coarse_ell)
   double ell = 0.0;            // final spatial length-scale
   bool ell_at_bound = false;   // final ell pinned at ell_min or at the (shrunk) ell_max
   int ell_bound_iterations = 0;  // iterations that ended with ell pinned at a bound
+  // Times ell reached ell_max and the bound was reduced: the length-scale gradient kept asking
+  // for a wider kernel, the sign of weak structure (the paper's "hard to track" signal).
+  int ell_max_reductions = 0;
   std::size_t nnz = 0;         // kept cross-kernel entries at the last iteration
   double inner_product = 0.0;  // <f_X, h.f_Z> / (|f_X| |f_Z|), in [0, 1]
   // Curvature of the objective F at the optimum w.r.t. a left perturbation

@@ -63,8 +63,8 @@ SelfSums selfKernelSums(const PreparedCloud& cloud, double ell, const SolverPara
 }
 
 CrossKernel::CrossKernel(const PreparedCloud& fixed, const PreparedCloud& moving,
-                         const SolverParams& params)
-    : fixed_(fixed), moving_(moving), params_(params) {
+                         const SolverParams& params, const VoxelGrid* grid)
+    : fixed_(fixed), moving_(moving), grid_(grid ? *grid : fixed.grid), params_(params) {
   y_.resize(moving_.size());
   chunks_.resize((moving_.size() + kChunk - 1) / kChunk);
   for (const auto& z : moving_.cloud.points) max_point_norm_ = std::max(max_point_norm_, z.norm());
@@ -91,7 +91,7 @@ void CrossKernel::buildCandidates(const Eigen::Isometry3d& T, float radius) {
     const int end = std::min(n, (c + 1) * kChunk);
     for (int j = c * kChunk; j < end; ++j) {
       const Eigen::Vector3f y = R * Z[j] + t;
-      fixed_.grid.forEachCandidate(y, [&](int i) {
+      grid_.forEachCandidate(y, [&](int i) {
         if (!((X[i] - y).squaredNorm() < radius2)) return;
         const float cf = colorFactor(fx[i], gz[j], color_inv, color_sigma2);
         if (sigma2 * cf < sp) return;  // fails at any distance
@@ -121,7 +121,7 @@ const CrossSums& CrossKernel::evaluate(const Eigen::Isometry3d& T, double ell) {
   // a point may have left the margin, or when the radius has shrunk enough that the lists carry
   // mostly useless candidates. The margin never exceeds the grid cell (the grid only
   // guarantees neighbours within one cell).
-  const float cell = fixed_.grid.cell();
+  const float cell = grid_.cell();
   if (r + moved > list_radius_ || list_radius_ > 1.6f * r + 0.005f) {
     buildCandidates(T, std::min(1.3f * r + 0.002f, std::max(cell, r)));
   }

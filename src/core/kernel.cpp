@@ -82,15 +82,20 @@ VoxelGrid::VoxelGrid(const std::vector<Eigen::Vector3f>& points, float cell) : c
   for (std::size_t i = 0; i < points.size(); ++i) order_[fill[cell_of[i]]++] = int(i);
 }
 
+float gridCell(double ell, const SolverParams& p) {
+  const double r2 = spatialRadius2(ell, p.sigma, p.sparsification);
+  // Cells a little larger than the search radius: the solver's candidate lists carry a margin
+  // beyond the radius and a grid only guarantees neighbours within one cell.
+  return std::isfinite(r2) && r2 > 0.0 ? 1.3f * float(std::sqrt(r2)) + 0.002f : 0.1f;
+}
+
 PreparedCloud prepareCloud(LabelledCloud cloud, const SolverParams& p) {
   const auto t0 = std::chrono::steady_clock::now();
   PreparedCloud out;
   out.cloud = std::move(cloud);
   const double r2 = spatialRadius2(largestEll(p), p.sigma, p.sparsification);
-  // Cells a little larger than the largest search radius: the solver's candidate lists carry a
-  // margin beyond the radius and the grid only guarantees neighbours within one cell.
-  const float cell = std::isfinite(r2) && r2 > 0.0 ? 1.3f * float(std::sqrt(r2)) + 0.002f : 0.1f;
-  out.grid = VoxelGrid(out.cloud.points, cell);
+  out.grid = VoxelGrid(out.cloud.points, gridCell(largestEll(p), p));
+  if (p.coarse_ell > 0.0) out.coarse_grid = VoxelGrid(out.cloud.points, gridCell(p.coarse_ell, p));
 
   const float sigma2 = float(p.sigma * p.sigma);
   const float color_sigma2 = float(p.color_sigma * p.color_sigma);

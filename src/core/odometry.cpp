@@ -104,9 +104,10 @@ OdometryResult Odometry::process(const Frame& frame) {
   } else if (s.status == SolverStatus::kMaxIterations) {
     r.tracking = Tracking::kHard;
     r.message = "iteration cap reached";
-  } else if (s.ell_at_bound) {
+  } else if (s.ell_max_reductions >= op.hard_ell_reductions) {
     r.tracking = Tracking::kHard;
-    r.message = "length-scale pinned at a bound";
+    r.message = "length-scale kept reaching its upper bound (" +
+                std::to_string(s.ell_max_reductions) + " reductions): weak structure";
   } else {
     r.tracking = Tracking::kOk;
   }

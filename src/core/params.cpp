@@ -140,7 +140,18 @@ std::string validate(const Params& p) {
   check(why, so.v_scale > 0.0, "solver.v_scale", "must be positive");
   check(why, so.max_iterations > 0, "solver.max_iterations", "must be positive");
   check(why, so.min_points > 0, "solver.min_points", "must be positive");
-  check(why, p.odometry.threads >= 0, "odometry.threads", "must not be negative (0 = all cores)");
+  check(why, so.coarse_ell >= 0.0, "solver.coarse_ell", "must not be negative (0 = off)");
+  check(why, so.coarse_points > 0, "solver.coarse_points", "must be positive");
+  check(why, so.coarse_iterations >= 0, "solver.coarse_iterations", "must not be negative");
+  const OdometryParams& od = p.odometry;
+  check(why, od.threads >= 0, "odometry.threads", "must not be negative (0 = all cores)");
+  check(why, od.lost_inner_product >= 0.0 && od.lost_inner_product <= od.hard_inner_product,
+        "odometry.lost_inner_product", "must lie within [0, hard_inner_product]");
+  check(why, od.hard_inner_product <= 1.0, "odometry.hard_inner_product", "must not exceed 1");
+  check(why, od.max_translation > 0.0, "odometry.max_translation", "must be positive");
+  check(why, od.max_rotation > 0.0, "odometry.max_rotation", "must be positive");
+  check(why, od.hard_ell_reductions > 0, "odometry.hard_ell_reductions", "must be positive");
+  check(why, od.covariance_scale > 0.0, "odometry.covariance_scale", "must be positive");
   return why.str();
 }
 
