@@ -72,6 +72,10 @@ class CrossKernel {
     std::vector<int> cand_end;      // per moving point of the chunk: end index into cand_*
     std::vector<int> cand_i;
     std::vector<float> cand_color;  // sigma_c^2 exp(-|f_i - g_j|^2 / 2 l_c^2)
+    // Copies of the candidates' coordinates, contiguous per moving point: the kernel pass runs
+    // over them with vector instructions instead of gathering fixed points by index.
+    std::vector<float> cand_x, cand_y, cand_z;
+    Eigen::ArrayXf scratch_d2, scratch_a;  // per-point work buffers (largest list of the chunk)
     std::vector<Pair> pairs;        // kept pairs of the last evaluate()
     std::vector<int> pair_end;      // per moving point of the chunk: end index into pairs
     CrossSums sums;
@@ -93,7 +97,6 @@ class CrossKernel {
   bool lists_valid_ = false;
   Eigen::Isometry3d list_T_ = Eigen::Isometry3d::Identity();
   float list_radius_ = 0.0f;
-  float max_point_norm_ = 0.0f;  // max |z_j| of the moving cloud
   int list_builds_ = 0;
 
  public:

@@ -22,6 +22,7 @@ struct IterationTrace {
   double ell = 0.0;      // length-scale used by the iteration
   double ell_max = 0.0;  // ell_max after the iteration's update
   double step = 0.0;     // step size t
+  double change = 0.0;   // t |xi|: the SE(3) change of the iteration
   double objective = 0.0;  // F before the update
   std::int64_t nnz = 0;
 };
@@ -32,6 +33,7 @@ struct SolverResult {
   SolverStatus status = SolverStatus::kTooFewPoints;
   int iterations = 0;          // main-stage iterations
   int coarse_iterations = 0;   // coarse-stage iterations (SolverParams::coarse_ell)
+  int list_builds = 0;         // candidate-list rebuilds of the main stage
   double ell = 0.0;            // final spatial length-scale
   bool ell_at_bound = false;   // final ell pinned at ell_min or at the (shrunk) ell_max
   int ell_bound_iterations = 0;  // iterations that ended with ell pinned at a bound

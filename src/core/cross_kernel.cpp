@@ -67,7 +67,6 @@ CrossKernel::CrossKernel(const PreparedCloud& fixed, const PreparedCloud& moving
     : fixed_(fixed), moving_(moving), grid_(grid ? *grid : fixed.grid), params_(params) {
   y_.resize(moving_.size());
   chunks_.resize((moving_.size() + kChunk - 1) / kChunk);
-  for (const auto& z : moving_.cloud.points) max_point_norm_ = std::max(max_point_norm_, z.norm());
 }
 
 void CrossKernel::buildCandidates(const Eigen::Isometry3d& T, float radius) {
@@ -88,6 +87,10 @@ void CrossKernel::buildCandidates(const Eigen::Isometry3d& T, float radius) {
     chunk.cand_end.clear();
     chunk.cand_i.clear();
     chunk.cand_color.clear();
+    chunk.cand_x.clear();
+    chunk.cand_y.clear();
+    chunk.cand_z.clear();
+    int longest = 0, start = 0;
     const int end = std::min(n, (c + 1) * kChunk);
     for (int j = c * kChunk; j < end; ++j) {
       const Eigen::Vector3f y = R * Z[j] + t;
@@ -97,8 +100,17 @@ void CrossKernel::buildCandidates(const Eigen::Isometry3d& T, float radius) {
         if (sigma2 * cf < sp) return;  // fails at any distance
         chunk.cand_i.push_back(i);
         chunk.cand_color.push_back(cf);
+        chunk.cand_x.push_back(X[i].x());
+        chunk.cand_y.push_back(X[i].y());
+        chunk.cand_z.push_back(X[i].z());
       });
       chunk.cand_end.push_back(int(chunk.cand_i.size()));
+      longest = std::max(longest, chunk.cand_end.back() - start);
+      start = chunk.cand_end.back();
+    }
+    if (chunk.scratch_d2.size() < longest) {
+      chunk.scratch_d2.resize(longest);
+      chunk.scratch_a.resize(longest);
     }
   });
   list_T_ = T;
@@ -111,12 +123,16 @@ const CrossSums& CrossKernel::evaluate(const Eigen::Isometry3d& T, double ell) {
   ell_ = ell;
   const double r2_exact = spatialRadius2(ell, params_.sigma, params_.sparsification);
   const float r = float(std::sqrt(std::min(r2_exact, 1e6)));
-  // How far any moving point can have moved since the lists were built: |dR z + dt| is at most
-  // ||dR||_F |z|max + |dt|.
-  const float moved =
-      lists_valid_ ? float((T.linear() - list_T_.linear()).norm() * max_point_norm_ +
-                           (T.translation() - list_T_.translation()).norm())
-                   : INFINITY;
+  // How far the moving points have moved since the lists were built (exactly: a bound through
+  // ||dR|| |z|max is loose enough to force a rebuild after a tenth of a degree).
+  float moved = INFINITY;
+  if (lists_valid_) {
+    const Eigen::Matrix3f dR = (T.linear() - list_T_.linear()).cast<float>();
+    const Eigen::Vector3f dt = (T.translation() - list_T_.translation()).cast<float>();
+    float worst2 = 0.0f;
+    for (const auto& z : moving_.cloud.points) worst2 = std::max(worst2, (dR * z + dt).squaredNorm());
+    moved = std::sqrt(worst2);
+  }
   // Lists are built with a margin so that several iterations reuse them; they are rebuilt when
   // a point may have left the margin, or when the radius has shrunk enough that the lists carry
   // mostly useless candidates. The margin never exceeds the grid cell (the grid only
@@ -151,19 +167,29 @@ const CrossSums& CrossKernel::evaluate(const Eigen::Isometry3d& T, double ell) {
       Eigen::Vector3f cross_sum = Eigen::Vector3f::Zero(), diff_sum = Eigen::Vector3f::Zero();
       float a_sum = 0.0f, ad2_sum = 0.0f;
       const int k_end = chunk.cand_end[j - c * kChunk];
-      for (; k < k_end; ++k) {
-        const int i = chunk.cand_i[k];
-        const Eigen::Vector3f d = y - X[i];
-        const float d2 = d.squaredNorm();
-        if (!(d2 < r2)) continue;
-        const float a = sigma2 * std::exp(-d2 * inv) * chunk.cand_color[k];
-        if (a < sp) continue;
-        chunk.pairs.push_back({i, a});
-        cross_sum += a * X[i].cross(y);
-        diff_sum += a * d;
-        a_sum += a;
-        ad2_sum += a * d2;
+      const int m = k_end - k;
+      if (m > 0) {
+        // Vectorised: squared distances and kernel values of all candidates of this point.
+        using Map = Eigen::Map<const Eigen::ArrayXf>;
+        auto d2 = chunk.scratch_d2.head(m);
+        auto a = chunk.scratch_a.head(m);
+        d2 = (Map(chunk.cand_x.data() + k, m) - y.x()).square() +
+             (Map(chunk.cand_y.data() + k, m) - y.y()).square() +
+             (Map(chunk.cand_z.data() + k, m) - y.z()).square();
+        a = sigma2 * (d2 * -inv).exp() * Map(chunk.cand_color.data() + k, m);
+        for (int q = 0; q < m; ++q) {
+          if (!(d2[q] < r2) || a[q] < sp) continue;
+          const int i = chunk.cand_i[k + q];
+          const float aq = a[q];
+          chunk.pairs.push_back({i, aq});
+          const Eigen::Vector3f d = y - X[i];
+          cross_sum += aq * X[i].cross(y);
+          diff_sum += aq * d;
+          a_sum += aq;
+          ad2_sum += aq * d2[q];
+        }
       }
+      k = k_end;
       chunk.pair_end.push_back(int(chunk.pairs.size()));
       omega += cross_sum.cast<double>();
       v += diff_sum.cast<double>();

@@ -205,7 +205,7 @@ SolverResult align(const PreparedCloud& fixed, const PreparedCloud& moving,
       break;
     }
     T = normalized(dT * T);
-    IterationTrace trace{used_ell, ell_max, step, s.F, s.nnz};
+    IterationTrace trace{used_ell, ell_max, step, step * xi.norm(), s.F, s.nnz};
 
     if (adaptive) {
       t0 = Clock::now();
@@ -239,6 +239,7 @@ SolverResult align(const PreparedCloud& fixed, const PreparedCloud& moving,
   }
   result.iterations = it;
   result.transform = T;
+  result.list_builds = kernel.candidateListBuilds();
 
   // Final figures at the returned transform.
   const double final_ell = adaptive ? ell : scheduledEll(it);
