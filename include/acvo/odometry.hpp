@@ -27,8 +27,9 @@ struct OdometryResult {
   Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
   // Covariance of the relative motion `motion` for a left perturbation motion -> exp(xi^) motion,
   // xi = (rotation x y z, translation x y z), expressed in the previous camera's frame; rad^2 and
-  // m^2. Model: covariance_scale * (-H)^-1 with H the curvature of the objective at the optimum
-  // (SolverResult::hessian); multiplied by 10 when tracking is hard; 1e6 on the diagonal when lost.
+  // m^2. Model: covariance_scale * (nnz / moving points) * (-H)^-1 with H the curvature of the
+  // objective at the optimum (SolverResult::hessian); multiplied by 10 when tracking is hard;
+  // 1e6 on the diagonal when lost.
   Eigen::Matrix<double, 6, 6> motion_covariance = Eigen::Matrix<double, 6, 6>::Identity();
   SolverResult solver;
   std::size_t fixed_points = 0;

@@ -56,9 +56,9 @@ struct OdometryParams {
   double max_translation = 0.3;   // m per frame
   double max_rotation = 20.0;     // deg per frame
   int hard_ell_reductions = 3;    // hard to track when ell_max was reduced this often in a frame
-  // Relative-motion covariance = covariance_scale * (-H)^-1, H the curvature of the objective at
-  // the optimum; see odometry.hpp.
-  double covariance_scale = 1.0;
+  // Relative-motion covariance = covariance_scale * (pairs per point) * (-H)^-1, H the curvature
+  // of the objective at the optimum; see odometry.hpp (calibration in config/acvo.yaml).
+  double covariance_scale = 6e-4;
 };
 
 struct Params {
