@@ -22,8 +22,8 @@
 #include <cstring>
 #include <stdexcept>
 
-#include <opencv2/imgproc.hpp>
 #include <tbb/global_control.h>
+#include <opencv2/imgproc.hpp>
 
 #include "acvo/depth.hpp"
 #include "acvo/frame.hpp"
@@ -34,12 +34,12 @@
 #include "acvo/solver.hpp"
 #include "fuzz_input.hpp"
 
-#define FUZZ_CHECK(cond)                                                              \
-  do {                                                                                \
-    if (!(cond)) {                                                                    \
+#define FUZZ_CHECK(cond)                                                                  \
+  do {                                                                                    \
+    if (!(cond)) {                                                                        \
       std::fprintf(stderr, "fuzz check failed: %s (%s:%d)\n", #cond, __FILE__, __LINE__); \
-      std::abort();                                                                   \
-    }                                                                                 \
+      std::abort();                                                                       \
+    }                                                                                     \
   } while (false)
 
 namespace {
@@ -99,7 +99,8 @@ cv::Mat depthImage(int w, int h, bool sixteen_bit, bool from_bytes, double scale
       } else {
         const double z = proceduralDepth(u, v, w, h, tiles.at(k)) * scale;
         if (sixteen_bit) {
-          raw.at<std::uint16_t>(v, u) = static_cast<std::uint16_t>(std::min(std::max(z, 0.0), 65535.0));
+          raw.at<std::uint16_t>(v, u) =
+              static_cast<std::uint16_t>(std::min(std::max(z, 0.0), 65535.0));
         } else {
           raw.at<float>(v, u) = static_cast<float>(z);
         }
@@ -147,11 +148,12 @@ Decoded decode(const std::uint8_t* data, std::size_t size) {
 
   const Tiles tiles(in.rest(), in.restSize());
   const int channels = order == 2 ? 1 : 3;
-  d.frame.order = order == 0 ? acvo::ColorOrder::kRgb
+  d.frame.order = order == 0   ? acvo::ColorOrder::kRgb
                   : order == 1 ? acvo::ColorOrder::kBgr
                                : acvo::ColorOrder::kGray;
   d.frame.color = colourImage(w, h, channels, tiles);
-  const double scale = std::isfinite(cam.depth_scale) && cam.depth_scale > 0 ? cam.depth_scale : 1.0;
+  const double scale =
+      std::isfinite(cam.depth_scale) && cam.depth_scale > 0 ? cam.depth_scale : 1.0;
   const cv::Mat raw = depthImage(w, h, sixteen_bit, depth_from_bytes, scale, tiles,
                                  static_cast<std::size_t>(w) * h * channels);
   if (!sixteen_bit && float_as_is) {
@@ -177,10 +179,13 @@ acvo::Frame shifted(const acvo::Frame& f, int dx, int dy) {
   return out;
 }
 
-bool finite(const Eigen::Isometry3d& T) { return T.matrix().allFinite(); }
+bool finite(const Eigen::Isometry3d& T) {
+  return T.matrix().allFinite();
+}
 
 void checkCloud(const acvo::LabelledCloud& c, const acvo::Frame& f) {
-  FUZZ_CHECK(c.labels.size() == c.size() && c.pixels.size() == c.size() && c.rgb.size() == c.size());
+  FUZZ_CHECK(c.labels.size() == c.size() && c.pixels.size() == c.size() &&
+             c.rgb.size() == c.size());
   FUZZ_CHECK(c.width == f.color.cols && c.height == f.color.rows);
   for (std::size_t k = 0; k < c.size(); ++k) {
     const cv::Point p = c.pixels[k];
