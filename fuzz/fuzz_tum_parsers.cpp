@@ -53,8 +53,15 @@ bool isRotation(const Eigen::Matrix3d& R) {
          std::abs(R.determinant() - 1.0) < 1e-9;
 }
 
+// An accepted stamp is a number: all of its text, which gives the stamp.
+bool isStamp(const std::string& text, double stamp) {
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  return end == text.c_str() + text.size() && value == stamp && std::isfinite(stamp);
+}
+
 void checkList(const std::vector<acvo::TumListEntry>& list) {
-  for (const auto& e : list) FUZZ_CHECK(std::isfinite(e.stamp) && !e.path.empty());
+  for (const auto& e : list) FUZZ_CHECK(isStamp(e.stamp_text, e.stamp) && !e.path.empty());
   const auto matches = acvo::associate(list, list, 0.02);
   FUZZ_CHECK(matches.size() <= list.size());
   for (std::size_t k = 0; k < matches.size(); ++k) {
@@ -65,7 +72,7 @@ void checkList(const std::vector<acvo::TumListEntry>& list) {
 
 void checkTrajectory(const acvo::Trajectory& t) {
   for (const auto& p : t) {
-    FUZZ_CHECK(std::isfinite(p.stamp) && p.pose.translation().allFinite());
+    FUZZ_CHECK(isStamp(p.stamp_text, p.stamp) && p.pose.translation().allFinite());
     FUZZ_CHECK(isRotation(p.pose.linear()));
   }
   acvo::writeTrajectory(scratch(1), t);
@@ -87,7 +94,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   tolerateExceptions([] { checkList(acvo::readTumList(scratch(0))); });
   tolerateExceptions([] {
     for (const auto& a : acvo::readAssociations(scratch(0))) {
-      FUZZ_CHECK(std::isfinite(a.rgb.stamp) && std::isfinite(a.depth.stamp));
+      FUZZ_CHECK(isStamp(a.rgb.stamp_text, a.rgb.stamp) &&
+                 isStamp(a.depth.stamp_text, a.depth.stamp));
     }
   });
   tolerateExceptions([] { checkTrajectory(acvo::readTrajectory(scratch(0))); });

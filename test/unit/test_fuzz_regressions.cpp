@@ -1,9 +1,13 @@
-// Inputs found by the fuzzers (fuzz/, scripts/test --fuzz) that once hung or crashed the core,
-// each reduced to the smallest case that shows the fault.
+// Inputs found by the fuzzers (fuzz/, scripts/test --fuzz) that once hung the core or broke one
+// of its contracts, each reduced to the smallest case that shows the fault.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
+#include <fstream>
 #include <limits>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -12,6 +16,8 @@
 #include "acvo/kernel.hpp"
 #include "acvo/labelled_cloud.hpp"
 #include "acvo/odometry.hpp"
+#include "acvo/tum.hpp"
+#include "test_support.hpp"
 
 namespace {
 
@@ -86,6 +92,27 @@ TEST(FuzzRegression, OdometryOnIntrinsicsBeyondTheFloatRange) {
     EXPECT_TRUE(r.pose.matrix().allFinite());
     EXPECT_TRUE(r.motion_covariance.allFinite());
   }
+}
+
+// A number field with a NUL byte inside ("130503110\0\0...") was read as the number before the
+// NUL: strtod stops there and the parser only checked that it stopped at a NUL.
+TEST(FuzzRegression, NumberFieldsWithANulByteAreMalformed) {
+  const auto dir = acvo::test::tempDir("fuzz_regression_nul");
+  const std::string nul(1, '\0');
+  auto write = [&](const std::string& name, const std::string& text) {
+    std::ofstream(dir / name, std::ios::binary) << text;
+    return (dir / name).string();
+  };
+  EXPECT_THROW(acvo::readTumList(write("rgb.txt", "1305031102.5" + nul + "7 rgb/a.png\n")),
+               std::runtime_error);
+  EXPECT_THROW(acvo::readAssociations(
+                   write("associations.txt", "1.0 rgb/a.png 1.0" + nul + nul + " depth/a.png\n")),
+               std::runtime_error);
+  EXPECT_THROW(acvo::readTrajectory(write("trajectory.txt", "1.0 0 0 0" + nul + "5 0 0 0 1\n")),
+               std::runtime_error);
+  // The same lines without the NUL bytes are fine.
+  EXPECT_EQ(acvo::readTumList(write("rgb_ok.txt", "1305031102.57 rgb/a.png\n")).size(), 1u);
+  EXPECT_EQ(acvo::readTrajectory(write("trajectory_ok.txt", "1.0 0 0 0 0 0 0 1\n")).size(), 1u);
 }
 
 }  // namespace
