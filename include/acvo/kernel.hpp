@@ -81,11 +81,15 @@ PreparedCloud prepareCloud(LabelledCloud cloud, const SolverParams& params);
 template <typename F>
 void VoxelGrid::forEachCandidate(const Eigen::Vector3f& q, F&& f) const {
   if (order_.empty()) return;
-  const Eigen::Vector3f r = (q - origin_) / cell_;
-  const int cx = static_cast<int>(std::floor(r.x()));
-  const int cy = static_cast<int>(std::floor(r.y()));
-  const int cz = static_cast<int>(std::floor(r.z()));
-  if (!(cx >= -1 && cy >= -1 && cz >= -1 && cx <= nx_ && cy <= ny_ && cz <= nz_)) return;
+  const Eigen::Vector3f r = ((q - origin_) / cell_).array().floor();
+  // Range check before the conversion to int: a query far outside the grid, or not finite,
+  // would not fit an int (undefined behaviour); NaN fails every comparison.
+  if (!(r.x() >= -1.0f && r.y() >= -1.0f && r.z() >= -1.0f && r.x() <= float(nx_) &&
+        r.y() <= float(ny_) && r.z() <= float(nz_))) {
+    return;
+  }
+  const int cx = static_cast<int>(r.x()), cy = static_cast<int>(r.y()),
+            cz = static_cast<int>(r.z());
   const int x0 = std::max(cx - 1, 0), x1 = std::min(cx + 1, nx_ - 1);
   if (x0 > x1) return;
   for (int z = std::max(cz - 1, 0); z <= std::min(cz + 1, nz_ - 1); ++z) {

@@ -49,17 +49,25 @@ double largestEll(const SolverParams& p) {
 
 VoxelGrid::VoxelGrid(const std::vector<Eigen::Vector3f>& points, float cell) : cell_(cell) {
   if (points.empty() || !(cell > 0.0f)) return;
-  Eigen::Vector3f lo = points.front(), hi = points.front();
+  // A non-finite point (from absurd intrinsics) has no place in the grid and no neighbours: it is
+  // left out, and the box spans the finite points only.
+  auto finite = [](const Eigen::Vector3f& p) { return p.allFinite(); };
+  const auto first = std::find_if(points.begin(), points.end(), finite);
+  if (first == points.end()) return;
+  Eigen::Vector3f lo = *first, hi = *first;
   for (const auto& p : points) {
+    if (!finite(p)) continue;
     lo = lo.cwiseMin(p);
     hi = hi.cwiseMax(p);
   }
   // A cloud spread far beyond the radius would make a huge dense grid: coarsen the cells then
-  // (candidates stay a superset of the true neighbours, searches only get slower).
+  // (candidates stay a superset of the true neighbours, searches only get slower). The extent is
+  // taken in double: hi - lo of finite floats may overflow float.
   constexpr double kMaxCells = 4e6;
+  const Eigen::Vector3d extent = hi.cast<double>() - lo.cast<double>();
   for (;;) {
-    const Eigen::Vector3f n = ((hi - lo) / cell_).array().floor() + 1.0f;
-    if (double(n.x()) * n.y() * n.z() <= kMaxCells) {
+    const Eigen::Vector3d n = (extent / double(cell_)).array().floor() + 1.0;
+    if (n.x() * n.y() * n.z() <= kMaxCells) {
       nx_ = int(n.x()), ny_ = int(n.y()), nz_ = int(n.z());
       break;
     }
@@ -67,19 +75,23 @@ VoxelGrid::VoxelGrid(const std::vector<Eigen::Vector3f>& points, float cell) : c
   }
   origin_ = lo;
   const int cells = nx_ * ny_ * nz_;
-  std::vector<int> cell_of(points.size());
+  const Eigen::Vector3f top(float(nx_ - 1), float(ny_ - 1), float(nz_ - 1));
+  std::vector<int> cell_of(points.size(), -1);
   cell_start_.assign(cells + 1, 0);
   for (std::size_t i = 0; i < points.size(); ++i) {
-    const Eigen::Vector3f r = (points[i] - origin_) / cell_;
-    const int x = std::min(int(r.x()), nx_ - 1), y = std::min(int(r.y()), ny_ - 1),
-              z = std::min(int(r.z()), nz_ - 1);
+    if (!finite(points[i])) continue;
+    // Clamped before the conversion to int: p - origin may overflow float to +inf.
+    const Eigen::Vector3f r = ((points[i] - origin_) / cell_).cwiseMin(top);
+    const int x = int(r.x()), y = int(r.y()), z = int(r.z());
     cell_of[i] = (z * ny_ + y) * nx_ + x;
     ++cell_start_[cell_of[i] + 1];
   }
   for (int c = 0; c < cells; ++c) cell_start_[c + 1] += cell_start_[c];
-  order_.resize(points.size());
+  order_.resize(cell_start_.back());
   std::vector<int> fill(cell_start_.begin(), cell_start_.end() - 1);
-  for (std::size_t i = 0; i < points.size(); ++i) order_[fill[cell_of[i]]++] = int(i);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (cell_of[i] >= 0) order_[fill[cell_of[i]]++] = int(i);
+  }
 }
 
 float gridCell(double ell, const SolverParams& p) {

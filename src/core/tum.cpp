@@ -60,10 +60,11 @@ std::vector<std::string> splitFields(const std::string& line) {
 }
 
 // The whole field must be a number (strtod accepts "nan" and "inf" as Python's float() does).
+// The end is checked against the field's size: strtod stops at a NUL byte inside the field.
 bool parseNumber(const std::string& field, double& value) {
   char* end = nullptr;
   value = std::strtod(field.c_str(), &end);
-  return end != field.c_str() && *end == '\0';
+  return end != field.c_str() && end == field.c_str() + field.size();
 }
 
 double parseStamp(const std::string& path, const Line& line, const std::string& field) {

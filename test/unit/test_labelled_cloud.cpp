@@ -289,7 +289,8 @@ TEST(LabelledCloud, KitchenFramesBuildQuickly) {
             << median(sel) << " ms, labels " << median(lab) << " ms), median " << median(points)
             << " points\n";
   // Generous bound (shared, loaded machines): the build must stay far from a 30 Hz frame time.
-  EXPECT_LT(median(total), 25.0);
+  // Not checked under the sanitizers, which slow everything down by design.
+  if (!test::kSanitizedBuild) EXPECT_LT(median(total), 25.0);
 }
 
 }  // namespace
