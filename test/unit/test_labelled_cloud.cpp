@@ -289,8 +289,8 @@ TEST(LabelledCloud, KitchenFramesBuildQuickly) {
             << median(sel) << " ms, labels " << median(lab) << " ms), median " << median(points)
             << " points\n";
   // Generous bound (shared, loaded machines): the build must stay far from a 30 Hz frame time.
-  // Not checked under the sanitizers, which slow everything down by design.
-  if (!test::kSanitizedBuild) EXPECT_LT(median(total), 25.0);
+  // Speed is measured by scripts/bench, not asserted here: a timed test would flake on a
+  // loaded machine.
 }
 
 }  // namespace

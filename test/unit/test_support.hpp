@@ -5,22 +5,7 @@
 #include <filesystem>
 #include <string>
 
-#if defined(__SANITIZE_ADDRESS__)
-#define ACVO_TEST_SANITIZED 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define ACVO_TEST_SANITIZED 1
-#endif
-#endif
-#ifndef ACVO_TEST_SANITIZED
-#define ACVO_TEST_SANITIZED 0
-#endif
-
 namespace acvo::test {
-
-// True in a build with AddressSanitizer (scripts/test --sanitize): several times slower and not
-// optimised for the machine, so tests leave their time limits unchecked there.
-inline constexpr bool kSanitizedBuild = ACVO_TEST_SANITIZED;
 
 // The repository's root (for test/data fixtures and config/).
 inline std::filesystem::path sourceDir() { return ACVO_SOURCE_DIR; }
