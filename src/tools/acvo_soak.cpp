@@ -244,7 +244,8 @@ int run(const Arguments& args) {
               counts[int(acvo::Tracking::kOk)], counts[int(acvo::Tracking::kHard)],
               counts[int(acvo::Tracking::kLost)], lost_on_faults,
               counts[int(acvo::Tracking::kFirstFrame)], counts[int(acvo::Tracking::kBadFrame)]);
-  std::printf("RSS: %ld KiB at start, %ld KiB at the end\n", rss_start, rss_end);
+  // The samples above are taken with a frame's images alive; these two between frames.
+  std::printf("RSS: %ld KiB before the first frame, %ld KiB after the last\n", rss_start, rss_end);
   if (rss_kib.size() >= 2) {
     std::printf(
         "RSS growth after %d frames of warm-up: %.1f KiB per 1000 frames (fit over %zu "
