@@ -11,6 +11,7 @@
 
 #include "acvo/kernel.hpp"
 #include "acvo/params.hpp"
+#include "acvo/se3.hpp"
 
 namespace acvo {
 
@@ -62,6 +63,11 @@ SolverResult align(const PreparedCloud& fixed, const PreparedCloud& moving,
 // Step size: the smallest positive real root of 4E t^3 + 3D t^2 + 2C t + B = 0; min_step when
 // there is none; capped at max_step. Double precision, degenerate leading terms handled.
 double solveStep(double B, double C, double D, double E, double min_step, double max_step);
+
+// Search direction of a conjugate-gradient iteration (Polak-Ribiere+) from the gradient g, the
+// previous gradient and the previous direction; always an ascent direction (d.g > 0), g itself
+// when the previous iteration gives nothing to build on.
+Vector6d conjugateDirection(const Vector6d& g, const Vector6d& g_prev, const Vector6d& d_prev);
 
 // The length-scale for a fixed-schedule iteration (CVO: 0.15, 0.10 after 2, 0.06 after 9,
 // 0.03 after 19).

@@ -33,6 +33,13 @@ struct EnumNames<InitialGuess> {
       {InitialGuess::kIdentity, "identity"}};
 };
 
+template <>
+struct EnumNames<SearchDirection> {
+  static constexpr std::pair<SearchDirection, const char*> table[] = {
+      {SearchDirection::kConjugateGradient, "conjugate_gradient"},
+      {SearchDirection::kGradient, "gradient"}};
+};
+
 template <typename Enum>
 std::string enumToString(Enum v) {
   for (const auto& [value, name] : EnumNames<Enum>::table) {
@@ -93,6 +100,9 @@ std::string toString(EllUpdate v) {
 std::string toString(InitialGuess v) {
   return enumToString(v);
 }
+std::string toString(SearchDirection v) {
+  return enumToString(v);
+}
 void fromString(const std::string& s, EllPolicy& v) {
   enumFromString(s, v);
 }
@@ -100,6 +110,9 @@ void fromString(const std::string& s, EllUpdate& v) {
   enumFromString(s, v);
 }
 void fromString(const std::string& s, InitialGuess& v) {
+  enumFromString(s, v);
+}
+void fromString(const std::string& s, SearchDirection& v) {
   enumFromString(s, v);
 }
 

@@ -75,10 +75,20 @@ double smallestPositiveCubic(double A3, double A2, double A1, double A0) {
   return best;
 }
 
-struct EllState {
-  double ell;
-  double ell_max;
-};
+}  // namespace
+
+Vector6d conjugateDirection(const Vector6d& g, const Vector6d& g_prev, const Vector6d& d_prev) {
+  const double g_prev2 = g_prev.squaredNorm();
+  if (!(g_prev2 > 0.0)) return g;
+  // Polak-Ribiere with the "+" restart: beta drops to 0 (plain gradient) when the gradient has
+  // turned so far that the previous direction no longer helps, e.g. after the length-scale moved.
+  const double beta = std::max(0.0, g.dot(g - g_prev) / g_prev2);
+  const Vector6d d = g + beta * d_prev;
+  // The line search only moves forward: a direction that does not ascend restarts from g.
+  return d.dot(g) > 0.0 && d.allFinite() ? d : g;
+}
+
+namespace {
 
 // The coarse result replaces the guess only when the main objective is this much larger there:
 // near the optimum the coarse stage's bias (a subset, a blurred objective) would otherwise cost
@@ -179,6 +189,8 @@ SolverResult align(const PreparedCloud& fixed, const PreparedCloud& moving,
   result.status = SolverStatus::kMaxIterations;
   int it = 0;
   double used_ell = ell;
+  const bool conjugate = p.direction == SearchDirection::kConjugateGradient;
+  Vector6d g_prev = Vector6d::Zero(), d_prev = Vector6d::Zero();
   for (; it < p.max_iterations; ++it) {
     used_ell = adaptive ? ell : scheduledEll(it);
     auto t0 = Clock::now();
@@ -193,12 +205,16 @@ SolverResult align(const PreparedCloud& fixed, const PreparedCloud& moving,
       break;
     }
 
+    Vector6d g;
+    g << s.omega, s.v;
+    const Vector6d xi = conjugate && it > 0 ? conjugateDirection(g, g_prev, d_prev) : g;
+    g_prev = g;
+    d_prev = xi;
     t0 = Clock::now();
-    const StepSums st = kernel.stepSums(s.omega, s.v);
+    // The step-size model holds for any direction: its root is a line search along xi.
+    const StepSums st = kernel.stepSums(xi.head<3>(), xi.tail<3>());
     const double step = solveStep(st.B, st.C, st.D, st.E, p.min_step, p.max_step);
     result.ms_step += msSince(t0);
-    Vector6d xi;
-    xi << s.omega, s.v;
     const Eigen::Isometry3d dT = expSE3(-step * xi);
     if (!dT.matrix().allFinite()) {
       result.status = SolverStatus::kNotFinite;

@@ -55,7 +55,7 @@ TEST(Params, ConfigFileHoldsEveryKeyWithTheStructDefaults) {
   const Params loaded = loadParams(path);
   const auto got = flatten(loaded);
   const auto want = flatten(Params());
-  ASSERT_EQ(got.size(), 34u);  // every parameter of visitParams
+  ASSERT_EQ(got.size(), 35u);  // every parameter of visitParams
   EXPECT_EQ(got, want);
   // Equal values could also come from keys missing in the file: check each key is written.
   const YAML::Node file = YAML::LoadFile(path);
@@ -74,6 +74,9 @@ TEST(Params, EveryKeyIsReadIntoItsField) {
                                                      : EllPolicy::kAdaptive);
     } else if constexpr (std::is_same_v<T, EllUpdate>) {
       value = toString(field == EllUpdate::kDescent ? EllUpdate::kReference : EllUpdate::kDescent);
+    } else if constexpr (std::is_same_v<T, SearchDirection>) {
+      value = toString(field == SearchDirection::kGradient ? SearchDirection::kConjugateGradient
+                                                           : SearchDirection::kGradient);
     } else if constexpr (std::is_same_v<T, InitialGuess>) {
       value = toString(field == InitialGuess::kIdentity ? InitialGuess::kConstantVelocity
                                                         : InitialGuess::kIdentity);
@@ -190,6 +193,14 @@ TEST(Params, EnumStringsRoundTrip) {
     fromString(toString(v), back);
     EXPECT_EQ(back, v);
   }
+  for (SearchDirection v : {SearchDirection::kConjugateGradient, SearchDirection::kGradient}) {
+    SearchDirection back = v == SearchDirection::kGradient ? SearchDirection::kConjugateGradient
+                                                           : SearchDirection::kGradient;
+    fromString(toString(v), back);
+    EXPECT_EQ(back, v);
+  }
+  EXPECT_EQ(toString(SearchDirection::kConjugateGradient), "conjugate_gradient");
+  EXPECT_EQ(toString(SearchDirection::kGradient), "gradient");
   EXPECT_EQ(toString(EllPolicy::kAdaptive), "adaptive");
   EXPECT_EQ(toString(EllPolicy::kFixedSchedule), "fixed_schedule");
   EXPECT_EQ(toString(EllUpdate::kDescent), "descent");
