@@ -246,7 +246,7 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
-TEST(LabelledCloud, KitchenFramesBuildQuickly) {
+TEST(LabelledCloud, KitchenFramesGiveFullCloudsWithinTheDepthRange) {
   const auto data = test::sharedDataDir();
   if (data.empty()) GTEST_SKIP() << "shared data (../shared/data) is absent";
   const auto dir = data / "kitchen7s_dev";
@@ -288,7 +288,6 @@ TEST(LabelledCloud, KitchenFramesBuildQuickly) {
   std::cout << "kitchen7s_dev 640x480: median build " << median(total) << " ms (selection "
             << median(sel) << " ms, labels " << median(lab) << " ms), median " << median(points)
             << " points\n";
-  // Generous bound (shared, loaded machines): the build must stay far from a 30 Hz frame time.
   // Speed is measured by scripts/bench, not asserted here: a timed test would flake on a
   // loaded machine.
 }
