@@ -14,21 +14,8 @@ namespace {
 
 using acvo::Camera;
 
-void writeText(const std::filesystem::path& path, const std::string& text) {
-  std::ofstream(path) << text;
-}
-
-// The message of the std::runtime_error `f` throws (fails the test when it throws none).
-template <typename F>
-std::string errorOf(F f) {
-  try {
-    f();
-  } catch (const std::runtime_error& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "no std::runtime_error thrown";
-  return {};
-}
+using acvo::test::errorOf;
+using acvo::test::writeText;
 
 TEST(Camera, TumNamesGiveThePublishedIntrinsics) {
   const Camera fr1 = acvo::cameraByName("fr1");

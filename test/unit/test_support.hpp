@@ -3,7 +3,11 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <stdexcept>
 #include <string>
+
+#include <gtest/gtest.h>
 
 namespace acvo::test {
 
@@ -27,6 +31,22 @@ inline std::filesystem::path tempDir(const std::string& name) {
   std::filesystem::remove_all(p);
   std::filesystem::create_directories(p);
   return p;
+}
+
+inline void writeText(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream(path) << text;
+}
+
+// The message of the std::runtime_error `f` throws (fails the test when it throws none).
+template <typename F>
+std::string errorOf(F f) {
+  try {
+    f();
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no std::runtime_error thrown";
+  return {};
 }
 
 }  // namespace acvo::test

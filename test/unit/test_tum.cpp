@@ -15,20 +15,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-void writeText(const fs::path& path, const std::string& text) {
-  std::ofstream(path) << text;
-}
-
-template <typename F>
-std::string errorOf(F f) {
-  try {
-    f();
-  } catch (const std::runtime_error& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "no std::runtime_error thrown";
-  return {};
-}
+using acvo::test::errorOf;
+using acvo::test::writeText;
 
 bool contains(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;
