@@ -13,6 +13,7 @@
 #include "acvo/odometry.hpp"
 #include "acvo/params.hpp"
 #include "acvo/tum.hpp"
+#include "tool_support.hpp"
 
 namespace {
 
@@ -103,14 +104,6 @@ acvo::Params loadParameters(const Options& o) {
   return p;
 }
 
-double percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const double pos = q * double(v.size() - 1);
-  const std::size_t lo = std::size_t(std::floor(pos)), hi = std::min(lo + 1, v.size() - 1);
-  return v[lo] + (pos - double(lo)) * (v[hi] - v[lo]);
-}
-
 // The ground-truth pose nearest in time to `stamp` (within 0.02 s, as TUM associates).
 const acvo::StampedPose* nearestPose(const acvo::Trajectory& gt, double stamp) {
   const acvo::StampedPose* best = nullptr;
@@ -144,7 +137,7 @@ int main(int argc, char** argv) {
       if (!stats) throw std::runtime_error("cannot write " + opt.stats);
       stats << "frame,stamp,tracking,status,points,fixed_points,iterations,ell,ell_at_bound,nnz,"
                "inner_product,ms_selection,ms_labels,ms_prepare,ms_cloud,ms_neighbours,ms_step,ms_ell,"
-               "ms_registration,ms_frame\n";
+               "ms_registration,ms_frame,rss_kib\n";
     }
 
     acvo::Odometry odometry(params);
@@ -188,7 +181,8 @@ int main(int argc, char** argv) {
               << s.iterations << ',' << s.ell << ',' << int(s.ell_at_bound) << ',' << s.nnz << ','
               << s.inner_product << ',' << r.cloud_stats.ms_selection << ','
               << r.cloud_stats.ms_labels << ',' << r.ms_prepare << ',' << r.ms_cloud << ',' << s.ms_neighbours << ','
-              << s.ms_step << ',' << s.ms_ell << ',' << r.ms_registration << ',' << ms << '\n';
+              << s.ms_step << ',' << s.ms_ell << ',' << r.ms_registration << ',' << ms << ','
+              << acvo::tools::residentKiB() << '\n';
       }
       if (progress) {
         std::fprintf(stderr, "\racvo_tum: frame %ld/%ld  %3d it  %6.1f ms  %s    ", k - first + 1,
@@ -199,7 +193,7 @@ int main(int argc, char** argv) {
     acvo::writeTrajectory(output, trajectory, "acvo trajectory of " + opt.dataset);
     std::printf("wrote %zu poses to %s\n", trajectory.size(), output.c_str());
     std::printf("frames=%zu median_ms=%.3f p90_ms=%.3f failures=%ld\n", trajectory.size(),
-                percentile(frame_ms, 0.5), percentile(frame_ms, 0.9), failures);
+                acvo::tools::percentile(frame_ms, 0.5), acvo::tools::percentile(frame_ms, 0.9), failures);
     return 0;
   } catch (const std::exception& e) {
     std::cerr << "acvo_tum: " << e.what() << "\n";
