@@ -32,6 +32,7 @@
 #include "acvo/AcvoConfig.h"
 #include "acvo/ResetToPose.h"
 #include "acvo/odometry.hpp"
+#include "cause_throttle.hpp"
 #include "conversions.hpp"
 #include "covariance.hpp"
 #include "messages.hpp"
@@ -48,6 +49,8 @@ namespace {
 constexpr double kTimeJumpBack = 1.0;
 // Warn when the synchroniser has produced nothing for this long (wall seconds).
 constexpr double kNoSyncWarning = 5.0;
+// Period of the warning about each cause of a skipped frame (s).
+constexpr double kSkipWarning = 5.0;
 
 double msSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
@@ -128,6 +131,7 @@ class OdometryNodelet : public nodelet::Nodelet {
   ros::WallTime last_frame_wall_;  // last synchronised frame, good or bad
   std::atomic<std::uint64_t> rgb_count_{0}, depth_count_{0}, info_count_{0};
   ros::WallTime last_sync_warning_;
+  CauseThrottle skip_warnings_{kSkipWarning};  // why frames are skipped, one slot per cause
 };
 
 void OdometryNodelet::onInit() {
@@ -274,7 +278,9 @@ void OdometryNodelet::processFrame(const Image& rgb, const Image& depth, const I
   last_tracking_ = r.tracking;
   last_message_ = r.message;
   if (r.tracking == acvo::Tracking::kBadFrame) {
-    NODELET_WARN_THROTTLE(5.0, "frame rejected by the odometry: %s", r.message.c_str());
+    if (skip_warnings_.allow(r.message, ros::WallTime::now().toSec())) {
+      NODELET_WARN("frame rejected by the odometry: %s", r.message.c_str());
+    }
     publishInfo(r, header, msSince(start));
     return;
   }
@@ -327,7 +333,9 @@ void OdometryNodelet::rejectFrame(const std_msgs::Header& header, const std::str
                                   double ms_total) {
   last_tracking_ = acvo::Tracking::kBadFrame;
   last_message_ = why;
-  NODELET_WARN_THROTTLE(5.0, "frame skipped: %s", why.c_str());
+  if (skip_warnings_.allow(why, ros::WallTime::now().toSec())) {
+    NODELET_WARN("frame skipped: %s", why.c_str());
+  }
   acvo::OdometryResult r;
   r.tracking = acvo::Tracking::kBadFrame;
   r.message = why;

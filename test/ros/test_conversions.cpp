@@ -1,5 +1,5 @@
-// The nodelet's message conversions, covariance model, stamp rules and parameter loading,
-// without a ROS master.
+// The nodelet's message conversions, covariance model, stamp rules, warning throttle and
+// parameter loading, without a ROS master.
 #include <cmath>
 #include <cstring>
 
@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <sensor_msgs/image_encodings.h>
 
+#include "cause_throttle.hpp"
 #include "conversions.hpp"
 #include "covariance.hpp"
 #include "messages.hpp"
@@ -272,6 +273,35 @@ TEST(StampCheck, DropsRepeatsRestartsOnJumpBackWarnsOnGaps) {
   EXPECT_EQ(checkStamp(100.0, 98.0, 1.0), StampVerdict::kRestart);
   EXPECT_EQ(checkStamp(100.0, 101.5, 1.0), StampVerdict::kGap);
   EXPECT_EQ(checkStamp(100.0, 101.5, 2.0), StampVerdict::kAccept);
+}
+
+TEST(CauseThrottle, OneSlotPerCauseSoAFrequentCauseHidesNoOther) {
+  const std::string truncated_a = "truncated data: 1000 bytes for 480 rows of step 1920";
+  const std::string truncated_b = "truncated data: 460800 bytes for 480 rows of step 1920";
+  const std::string focal = "camera_info K has a zero focal length (fx 0, fy 0)";
+  EXPECT_EQ(causeOf(truncated_a), "truncated data: # bytes for # rows of step #");
+  EXPECT_EQ(causeOf(truncated_a), causeOf(truncated_b));
+  EXPECT_NE(causeOf(truncated_a), causeOf(focal));
+
+  CauseThrottle throttle(5.0);
+  EXPECT_TRUE(throttle.allow(truncated_a, 100.0));
+  EXPECT_FALSE(throttle.allow(truncated_b, 101.0));  // same cause within the period
+  EXPECT_TRUE(throttle.allow(focal, 101.5));         // another cause is told at once
+  EXPECT_FALSE(throttle.allow(focal, 106.0));
+  EXPECT_TRUE(throttle.allow(truncated_b, 105.0));  // the period since 100 is over
+  EXPECT_FALSE(throttle.allow(truncated_a, 109.9));
+  EXPECT_TRUE(throttle.allow(focal, 106.5));
+}
+
+TEST(CauseThrottle, CausesBeyondTheLimitShareOneSlot) {
+  CauseThrottle throttle(5.0, 2);
+  EXPECT_TRUE(throttle.allow("unsupported encoding 'aaa'", 0.0));
+  EXPECT_TRUE(throttle.allow("unsupported encoding 'bbb'", 0.0));
+  // Names from the input must not grow the table: the third and fourth cause share a slot.
+  EXPECT_TRUE(throttle.allow("unsupported encoding 'ccc'", 0.0));
+  EXPECT_FALSE(throttle.allow("unsupported encoding 'ddd'", 1.0));
+  EXPECT_TRUE(throttle.allow("unsupported encoding 'ddd'", 6.0));
+  EXPECT_FALSE(throttle.allow("unsupported encoding 'aaa'", 4.0));  // its own slot still counts
 }
 
 XmlRpc::XmlRpcValue section(const std::string& key, const XmlRpc::XmlRpcValue& value) {
