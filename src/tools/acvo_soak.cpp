@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "acvo/odometry.hpp"
+#include "tool_support.hpp"
 #include "synth/sequence.hpp"
 
 namespace {
@@ -89,21 +90,6 @@ Arguments parseArguments(int argc, char** argv) {
   return a;
 }
 
-// Resident set size of this process in KiB (VmRSS of /proc/self/status); -1 when unreadable.
-long residentKiB() {
-  std::ifstream status("/proc/self/status");
-  std::string key;
-  while (status >> key) {
-    if (key == "VmRSS:") {
-      long kib = -1;
-      status >> kib;
-      return kib;
-    }
-    status.ignore(std::numeric_limits<std::streamsize>::max(), '\n');
-  }
-  return -1;
-}
-
 enum class Fault { kNone, kBlank, kZeroDepth, kNanDepth, kBlackout, kStampBack };
 
 const char* toString(Fault f) {
@@ -161,13 +147,6 @@ acvo::Frame inject(acvo::Frame frame, Fault fault, double previous_stamp) {
   return frame;
 }
 
-double percentile(std::vector<double> values, double q) {
-  if (values.empty()) return 0.0;
-  const auto k = static_cast<std::size_t>(q * (values.size() - 1) + 0.5);
-  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
-  return values[k];
-}
-
 // Least-squares slope of y over x (0 with fewer than two samples).
 double slope(const std::vector<double>& x, const std::vector<double>& y) {
   const std::size_t n = x.size();
@@ -199,7 +178,7 @@ int run(const Arguments& args) {
   int counts[5] = {}, lost_on_faults = 0, fault_frames = 0;
   double max_translation = 0.0;
   bool all_finite = true;
-  const long rss_start = residentKiB();
+  const long rss_start = acvo::tools::residentKiB();
   double previous_stamp = 0.0;
 
   for (int i = 0; i < args.frames; ++i) {
@@ -227,18 +206,18 @@ int run(const Arguments& args) {
     const int done = i + 1;
     if (done % kSampleEvery == 0 && done >= kWarmup) {
       rss_frame.push_back(done);
-      rss_kib.push_back(static_cast<double>(residentKiB()));
+      rss_kib.push_back(static_cast<double>(acvo::tools::residentKiB()));
     }
     if (done % kReportEvery == 0) {
       std::printf("frame %6d  rss %8ld KiB  lost %5d  hard %5d  ok %6d  median %.1f ms\n", done,
-                  residentKiB(), counts[int(acvo::Tracking::kLost)],
+                  acvo::tools::residentKiB(), counts[int(acvo::Tracking::kLost)],
                   counts[int(acvo::Tracking::kHard)], counts[int(acvo::Tracking::kOk)],
-                  percentile(ms, 0.5));
+                  acvo::tools::percentile(ms, 0.5));
       std::fflush(stdout);
     }
   }
 
-  const long rss_end = residentKiB();
+  const long rss_end = acvo::tools::residentKiB();
   std::printf("\nframes processed: %d (%d carried a fault)\n", args.frames, fault_frames);
   std::printf("tracking: ok %d, hard %d, lost %d (%d of them on fault frames), first %d, bad %d\n",
               counts[int(acvo::Tracking::kOk)], counts[int(acvo::Tracking::kHard)],
@@ -256,7 +235,7 @@ int run(const Arguments& args) {
     std::printf("RSS growth: n/a (needs more than %d frames)\n", kWarmup + kSampleEvery);
   }
   std::printf("Odometry::process: median %.1f ms, p90 %.1f ms, max %.1f ms per frame\n",
-              percentile(ms, 0.5), percentile(ms, 0.9), *std::max_element(ms.begin(), ms.end()));
+              acvo::tools::percentile(ms, 0.5), acvo::tools::percentile(ms, 0.9), *std::max_element(ms.begin(), ms.end()));
   std::printf("max |pose translation|: %.3f m; all poses finite: %s\n", max_translation,
               all_finite ? "yes" : "NO");
   return all_finite ? 0 : 1;
