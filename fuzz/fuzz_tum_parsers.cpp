@@ -29,14 +29,23 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// One pair of scratch files per process (libFuzzer's -jobs runs several processes).
+// One pair of scratch files per process (libFuzzer's -jobs runs several processes), removed when
+// the process exits normally.
+struct ScratchFiles {
+  std::string paths[2];
+  ScratchFiles() {
+    const std::string stem = "acvo_fuzz_tum_" + std::to_string(getpid());
+    paths[0] = (fs::temp_directory_path() / (stem + "_a.txt")).string();
+    paths[1] = (fs::temp_directory_path() / (stem + "_b.txt")).string();
+  }
+  ~ScratchFiles() {
+    for (const std::string& p : paths) std::remove(p.c_str());
+  }
+};
+
 const std::string& scratch(int k) {
-  static const std::string paths[2] = {
-      (fs::temp_directory_path() / ("acvo_fuzz_tum_" + std::to_string(getpid()) + "_a.txt"))
-          .string(),
-      (fs::temp_directory_path() / ("acvo_fuzz_tum_" + std::to_string(getpid()) + "_b.txt"))
-          .string()};
-  return paths[k];
+  static const ScratchFiles files;
+  return files.paths[k];
 }
 
 template <typename F>
