@@ -41,6 +41,10 @@ struct SolverParams {
   double omega_scale = 7.0;     // c: omega = (1/c) sum a (x cross y)
   double v_scale = 7.0;         // d: v = (1/d) sum a (y - x)
   int max_iterations = 200;     // reference code: 2000 (too many for real time)
+  // Stop when F has not improved for this many iterations at an unchanged length-scale and
+  // return the best transform seen (not in the paper: with ell pinned at ell_min the iterates
+  // otherwise jitter around the optimum until the cap). 0 = off.
+  int stall_iterations = 6;
   // Coarse stage (not in the paper): before the main iterations, a few CVO iterations with a
   // wide fixed length-scale on a subset of the moving points widen the basin of convergence
   // (a 5 degree rotation moves points 17 cm at 2 m, beyond the reach of ell_max). 0 = off.
@@ -108,6 +112,7 @@ void visitParams(Params_& p, Visitor&& visit) {
   visit("solver", "omega_scale", p.solver.omega_scale);
   visit("solver", "v_scale", p.solver.v_scale);
   visit("solver", "max_iterations", p.solver.max_iterations);
+  visit("solver", "stall_iterations", p.solver.stall_iterations);
   visit("solver", "coarse_ell", p.solver.coarse_ell);
   visit("solver", "coarse_points", p.solver.coarse_points);
   visit("solver", "coarse_iterations", p.solver.coarse_iterations);

@@ -34,6 +34,9 @@ struct SolverResult {
   SolverStatus status = SolverStatus::kTooFewPoints;
   int iterations = 0;          // main-stage iterations
   int coarse_iterations = 0;   // coarse-stage iterations (SolverParams::coarse_ell)
+  // Stopped by the stall rule (SolverParams::stall_iterations): the transform is the best
+  // iterate at the final length-scale, not the last one.
+  bool stalled = false;
   int list_builds = 0;         // candidate-list rebuilds of the main stage
   double ell = 0.0;            // final spatial length-scale
   bool ell_at_bound = false;   // final ell pinned at ell_min or at the (shrunk) ell_max

@@ -152,6 +152,7 @@ std::string validate(const Params& p) {
   check(why, so.omega_scale > 0.0, "solver.omega_scale", "must be positive");
   check(why, so.v_scale > 0.0, "solver.v_scale", "must be positive");
   check(why, so.max_iterations > 0, "solver.max_iterations", "must be positive");
+  check(why, so.stall_iterations >= 0, "solver.stall_iterations", "must not be negative");
   check(why, so.min_points > 0, "solver.min_points", "must be positive");
   check(why, so.coarse_ell >= 0.0, "solver.coarse_ell", "must not be negative (0 = off)");
   check(why, so.coarse_points > 0, "solver.coarse_points", "must be positive");

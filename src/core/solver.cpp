@@ -191,6 +191,11 @@ SolverResult align(const PreparedCloud& fixed, const PreparedCloud& moving,
   double used_ell = ell;
   const bool conjugate = p.direction == SearchDirection::kConjugateGradient;
   Vector6d g_prev = Vector6d::Zero(), d_prev = Vector6d::Zero();
+  // Stagnation at an unchanged length-scale (SolverParams::stall_iterations): the best
+  // transform seen at this length-scale and how many iterations ago it was found.
+  double stall_ell = -1.0, best_F = -INFINITY;
+  Eigen::Isometry3d best_T = T;
+  int stalled = 0;
   for (; it < p.max_iterations; ++it) {
     used_ell = adaptive ? ell : scheduledEll(it);
     auto t0 = Clock::now();
@@ -203,6 +208,24 @@ SolverResult align(const PreparedCloud& fixed, const PreparedCloud& moving,
     if (s.omega.norm() < p.eps_gradient && s.v.norm() < p.eps_gradient) {
       result.status = SolverStatus::kConverged;
       break;
+    }
+    // A fixed schedule still has coarser stages to leave: only its last one can stall.
+    if (p.stall_iterations > 0 && (adaptive || used_ell == scheduledEll(p.max_iterations))) {
+      if (used_ell != stall_ell) {
+        stall_ell = used_ell;
+        best_F = s.F;
+        best_T = T;
+        stalled = 0;
+      } else if (s.F > best_F) {
+        best_F = s.F;
+        best_T = T;
+        stalled = 0;
+      } else if (++stalled >= p.stall_iterations) {
+        T = best_T;
+        result.stalled = true;
+        result.status = SolverStatus::kConverged;
+        break;
+      }
     }
 
     Vector6d g;

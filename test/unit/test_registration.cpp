@@ -1,4 +1,7 @@
 // Whole registrations on rendered image pairs with exactly known motion (noise-free).
+#include <algorithm>
+#include <vector>
+
 #include <gtest/gtest.h>
 
 #include "acvo/kernel.hpp"
@@ -8,6 +11,7 @@
 #include "synth/layout.hpp"
 #include "synth/renderer.hpp"
 #include "synth/scene.hpp"
+#include "synth/sequence.hpp"
 
 namespace acvo {
 namespace {
@@ -59,6 +63,60 @@ TEST_P(Registration, RecoversKnownMotionsOfARenderedRoom) {
 INSTANTIATE_TEST_SUITE_P(BothPolicies, Registration,
                          ::testing::Values(EllPolicy::kAdaptive, EllPolicy::kFixedSchedule),
                          [](const auto& info) { return toString(info.param); });
+
+
+// The stall rule (SolverParams::stall_iterations) on the case it was made for: a room of flat
+// colours seen by a noisy sensor, where the adaptive length-scale often settles at ell_min and
+// the iterates then circle the optimum without improving the objective. Consecutive frames of
+// a synthetic sequence, each registration started from the true previous motion.
+TEST(StallRule, CutsIterationsOnAnUntexturedRoomWithoutLosingAccuracy) {
+  synth::SequenceOptions o;
+  o.frames = 41;
+  o.texture = false;
+  const synth::SynthSequence seq(o);
+  Params params;
+  const int stall_default = params.solver.stall_iterations;
+  ASSERT_GT(stall_default, 0);
+  std::vector<PreparedCloud> clouds;
+  for (int i = 0; i < seq.size(); ++i)
+    clouds.push_back(prepareCloud(buildLabelledCloud(seq.frame(i).toFrame(), params.selection),
+                                  params.solver));
+  int iterations[2] = {0, 0}, stalled = 0;
+  double sum_mm[2] = {0, 0}, sum_deg[2] = {0, 0};
+  for (int i = 1; i + 1 < seq.size(); ++i) {
+    const Eigen::Isometry3d truth = seq.poses()[i].inverse() * seq.poses()[i + 1];
+    const Eigen::Isometry3d guess = seq.poses()[i - 1].inverse() * seq.poses()[i];
+    for (int on : {0, 1}) {
+      params.solver.stall_iterations = on ? stall_default : 0;
+      const SolverResult r = align(clouds[i], clouds[i + 1], guess, params.solver);
+      ASSERT_NE(r.status, SolverStatus::kNotFinite);
+      const Vector6d err = logSE3(truth.inverse() * r.transform);
+      iterations[on] += r.iterations;
+      sum_mm[on] += 1000.0 * err.tail<3>().norm();
+      sum_deg[on] += err.head<3>().norm() * 180 / M_PI;
+      // The returned transform is the best seen at the final length-scale.
+      EXPECT_TRUE(on || !r.stalled);
+      if (r.stalled) {
+        ++stalled;
+        EXPECT_EQ(r.status, SolverStatus::kConverged);
+        double best = -1.0;
+        for (const IterationTrace& t : r.trace)
+          if (t.ell == r.ell) best = std::max(best, t.objective);
+        EXPECT_GE(r.objective, best - 1e-12) << "frame " << i;
+      }
+    }
+  }
+  const int pairs = seq.size() - 2;
+  std::printf("  stall off: %d iterations, mean error %.3f mm %.4f deg\n", iterations[0],
+              sum_mm[0] / pairs, sum_deg[0] / pairs);
+  std::printf("  stall on:  %d iterations, mean error %.3f mm %.4f deg (%d stopped by the "
+              "rule)\n", iterations[1], sum_mm[1] / pairs, sum_deg[1] / pairs, stalled);
+  // Measured: 1887 -> 1755 iterations, 2.47 -> 2.10 mm, 0.061 -> 0.054 deg, 7 of 39 stopped.
+  EXPECT_GE(stalled, 3);
+  EXPECT_LT(iterations[1], iterations[0]);
+  EXPECT_LT(sum_mm[1], 1.1 * sum_mm[0]);
+  EXPECT_LT(sum_deg[1], 1.1 * sum_deg[0]);
+}
 
 }  // namespace
 }  // namespace acvo
