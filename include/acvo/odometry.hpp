@@ -43,8 +43,10 @@ struct OdometryResult {
 // Tracking judgement of a registered frame:
 //  - lost: the solver failed (too few points, not finite), the normalised inner product is below
 //    lost_inner_product, or the motion exceeds max_translation / max_rotation per frame. The pose
-//    is kept, the motion prior is dropped and the reference is re-seeded from this frame (kept
-//    when this frame has too few points, so a blank frame does not erase a good reference).
+//    is kept and the motion prior is dropped. The reference is re-seeded from this frame only
+//    when the previous frame was lost too (or the reference has too few points), and never
+//    from a frame with too few points: a single bad frame or a blank stretch does not erase a
+//    good reference, and the next frame is registered against the last good one.
 //  - hard: inner product below hard_inner_product, iteration cap reached, or the length-scale
 //    reached its upper bound at least hard_ell_reductions times (each time the bound shrinks).
 //  - ok otherwise.
@@ -72,6 +74,7 @@ class Odometry {
   Eigen::Isometry3d pose_ = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();  // last relative motion
   std::optional<PreparedCloud> reference_;
+  bool last_lost_ = false;  // the previous frame was lost (see the judgement above)
   struct Arena;  // the thread pool the solver runs in (odometry.threads)
   std::unique_ptr<Arena> arena_;
 };

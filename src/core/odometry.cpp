@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <sstream>
 
 #include <Eigen/Eigenvalues>
 #include <tbb/task_arena.h>
@@ -37,7 +38,22 @@ void Odometry::reset(const Eigen::Isometry3d& pose) {
   pose_ = pose;
   velocity_ = Eigen::Isometry3d::Identity();
   reference_.reset();
+  last_lost_ = false;
 }
+
+namespace {
+// Why a frame gave too few points, from what the selector saw: the message names the fault
+// of the input (a blank colour image, a depth image without valid values) rather than the
+// solver's status alone.
+std::string whyTooFewPoints(const CloudStats& stats, const SelectionParams& p) {
+  const int candidates = stats.selection.gradient_pixels + stats.selection.canny_pixels;
+  if (candidates == 0) return "no intensity gradient anywhere in the colour image";
+  std::ostringstream why;
+  why << "no valid depth in [" << p.min_depth << ", " << p.max_depth << "] m at its "
+      << candidates << " candidate pixels";
+  return why.str();
+}
+}  // namespace
 
 const LabelledCloud* Odometry::lastCloud() const {
   return reference_ ? &reference_->cloud : nullptr;
@@ -65,6 +81,7 @@ OdometryResult Odometry::process(const Frame& frame) {
   r.ms_prepare = current->ms_prepare;
 
   if (!reference_) {
+    last_lost_ = false;
     reference_ = std::move(current);
     r.tracking = Tracking::kFirstFrame;
     r.fixed_points = 0;
@@ -90,6 +107,11 @@ OdometryResult Odometry::process(const Frame& frame) {
     r.message = "registration failed: " + toString(s.status) + " (" +
                 std::to_string(r.fixed_points) + " and " + std::to_string(r.moving_points) +
                 " points)";
+    if (too_few) {
+      r.message += int(r.moving_points) < params_.solver.min_points
+                       ? ": this frame has " + whyTooFewPoints(r.cloud_stats, params_.selection)
+                       : ": the reference frame has too few points";
+    }
   } else if (s.inner_product < op.lost_inner_product) {
     r.tracking = Tracking::kLost;
     r.message = "clouds do not overlap (normalised inner product " +
@@ -117,13 +139,22 @@ OdometryResult Odometry::process(const Frame& frame) {
     velocity_ = Eigen::Isometry3d::Identity();
     r.motion = Eigen::Isometry3d::Identity();
     r.motion_covariance = Eigen::Matrix<double, 6, 6>::Identity() * 1e6;
-    if (!too_few || int(current->size()) >= params_.solver.min_points) {
+    // Re-seed the reference from this frame when it has points enough and either the
+    // reference has not or the previous frame was lost too. The first lost frame after a
+    // tracked one keeps the reference: one bad frame (noise, a glitch) must not replace a
+    // good reference, and the next frame is registered against it (measured: a frame of noise
+    // otherwise cost the motion of two frames). A blank frame never replaces it.
+    const int min_points = params_.solver.min_points;
+    if (int(current->size()) >= min_points &&
+        (int(reference_->size()) < min_points || last_lost_)) {
       reference_ = std::move(current);
     }
+    last_lost_ = true;
     r.pose = pose_;
     return r;
   }
 
+  last_lost_ = false;
   r.motion = s.transform;
   velocity_ = s.transform;
   pose_ = normalized(pose_ * s.transform);
