@@ -73,6 +73,7 @@ class Odometry {
   Params params_;
   Eigen::Isometry3d pose_ = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();  // last relative motion
+  double velocity_interval_ = 0.0;  // s between the two frames of velocity_ (0: unknown)
   std::optional<PreparedCloud> reference_;
   bool last_lost_ = false;  // the previous frame was lost (see the judgement above)
   struct Arena;  // the thread pool the solver runs in (odometry.threads)
