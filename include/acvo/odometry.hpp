@@ -43,10 +43,10 @@ struct OdometryResult {
 // Tracking judgement of a registered frame:
 //  - lost: the solver failed (too few points, not finite), the normalised inner product is below
 //    lost_inner_product, or the motion exceeds max_translation / max_rotation per frame. The pose
-//    is kept and the motion prior is dropped. The reference is re-seeded from this frame only
-//    when the previous frame was lost too (or the reference has too few points), and never
-//    from a frame with too few points: a single bad frame or a blank stretch does not erase a
-//    good reference, and the next frame is registered against the last good one.
+//    is kept and the motion prior is dropped. The reference is re-seeded from this frame,
+//    except from a frame with too few points (blank) and from a first lost frame that has next
+//    to nothing in common with it (inner product below lost_inner_product / 5: noise): then
+//    the next frame is registered against the last good one.
 //  - hard: inner product below hard_inner_product, iteration cap reached, or the length-scale
 //    reached its upper bound at least hard_ell_reductions times (each time the bound shrinks).
 //  - ok otherwise.
