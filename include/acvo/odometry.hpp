@@ -43,8 +43,10 @@ struct OdometryResult {
 // Tracking judgement of a registered frame:
 //  - lost: the solver failed (too few points, not finite), the normalised inner product is below
 //    lost_inner_product, or the motion exceeds max_translation / max_rotation per frame. The pose
-//    is kept, the motion prior is dropped and the reference is re-seeded from this frame (kept
-//    when this frame has too few points, so a blank frame does not erase a good reference).
+//    is kept and the motion prior is dropped. The reference is re-seeded from this frame,
+//    except from a frame with too few points (blank) and from a first lost frame that has next
+//    to nothing in common with it (inner product below lost_inner_product / 5: noise): then
+//    the next frame is registered against the last good one.
 //  - hard: inner product below hard_inner_product, iteration cap reached, or the length-scale
 //    reached its upper bound at least hard_ell_reductions times (each time the bound shrinks).
 //  - ok otherwise.
@@ -71,7 +73,9 @@ class Odometry {
   Params params_;
   Eigen::Isometry3d pose_ = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();  // last relative motion
+  double velocity_interval_ = 0.0;  // s between the two frames of velocity_ (0: unknown)
   std::optional<PreparedCloud> reference_;
+  bool last_lost_ = false;  // the previous frame was lost (see the judgement above)
   struct Arena;  // the thread pool the solver runs in (odometry.threads)
   std::unique_ptr<Arena> arena_;
 };

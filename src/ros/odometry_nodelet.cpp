@@ -273,6 +273,10 @@ void OdometryNodelet::processFrame(const Image& rgb, const Image& depth, const I
     base_from_camera_.reset();
   }
 
+  // The motion of a registered frame spans the time since the engine's reference, which is
+  // not the last frame processed when lost frames came between (a blackout, a frame of noise).
+  const acvo::LabelledCloud* reference = odometry_->lastCloud();
+  const double reference_stamp = reference ? reference->stamp : 0.0;
   const acvo::OdometryResult r = odometry_->process(*frame);
   ++frames_;
   last_tracking_ = r.tracking;
@@ -284,7 +288,7 @@ void OdometryNodelet::processFrame(const Image& rgb, const Image& depth, const I
     publishInfo(r, header, msSince(start));
     return;
   }
-  const double dt = last_stamp_.isZero() ? 0.0 : (header.stamp - last_stamp_).toSec();
+  const double dt = reference_stamp > 0.0 ? frame->stamp - reference_stamp : 0.0;
   last_stamp_ = header.stamp;
 
   if (r.tracking == acvo::Tracking::kLost) {

@@ -19,6 +19,7 @@
 #include <gtest/gtest.h>
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
+#include <rosgraph_msgs/Log.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <std_srvs/Empty.h>
 #include <tf2_eigen/tf2_eigen.h>
@@ -103,6 +104,7 @@ class Client {
     odom_sub_ = nh_.subscribe("odom", 100, &Client::onOdom, this);
     info_sub_ = nh_.subscribe("odom_info", 100, &Client::onInfo, this);
     diag_sub_ = nh_.subscribe("/diagnostics", 100, &Client::onDiagnostics, this);
+    rosout_sub_ = nh_.subscribe("/rosout", 1000, &Client::onLog, this);
     reset_ = nh_.serviceClient<std_srvs::Empty>("reset_odom");
     reset_to_pose_ = nh_.serviceClient<acvo::ResetToPose>("reset_odom_to_pose");
     next_stamp_ = ros::Time::now();
@@ -126,6 +128,8 @@ class Client {
     next_stamp_ += ros::Duration(0.1);
     return next_stamp_;
   }
+  // A pause in the stream: the next stamp comes `seconds` later than it would have.
+  void skipTime(double seconds) { next_stamp_ += ros::Duration(seconds); }
 
   // Publishes one frame; `mutate` may spoil any of the three messages.
   template <typename Mutate>
@@ -179,16 +183,25 @@ class Client {
   // one frame in flight so the approximate policy can release each set.
   std::vector<Outcome> run(const std::vector<int>& indices,
                            std::vector<ros::Time>* stamps = nullptr) {
+    std::vector<RgbdImage> images;
     std::vector<ros::Time> sent;
-    std::vector<Outcome> out;
-    for (std::size_t i = 0; i < indices.size(); ++i) {
+    for (int k : indices) {
+      images.push_back(frame(k));
       sent.push_back(nextStamp());
-      send(frame(indices[i]), sent.back());
-      if (i > 0) out.push_back(outcome(sent[i - 1], true));
+    }
+    if (stamps) *stamps = sent;
+    return run(images, sent);
+  }
+  // The same with the images and stamps given.
+  std::vector<Outcome> run(const std::vector<RgbdImage>& images,
+                           const std::vector<ros::Time>& stamps) {
+    std::vector<Outcome> out;
+    for (std::size_t i = 0; i < images.size(); ++i) {
+      send(images[i], stamps[i]);
+      if (i > 0) out.push_back(outcome(stamps[i - 1], true));
     }
     flush();
-    out.push_back(outcome(sent.back(), true));
-    if (stamps) *stamps = sent;
+    out.push_back(outcome(stamps.back(), true));
     return out;
   }
 
@@ -207,6 +220,39 @@ class Client {
     RgbdImage img = frame(0);
     RgbdImage out{img.rgb.clone(), cv::Mat::zeros(img.depth.size(), CV_32FC1)};
     return out;
+  }
+
+  // Frame k's depth with one colour everywhere: no intensity gradient to select points from.
+  RgbdImage flatColour(int k) {
+    return {cv::Mat(frame(k).rgb.size(), CV_8UC3, cv::Scalar(128, 128, 128)), frame(k).depth};
+  }
+  // Frame k's colour with depth beyond the range everywhere (100 m; 65.5 m in 16UC1).
+  RgbdImage farDepth(int k) {
+    return {frame(k).rgb, cv::Mat(frame(k).depth.size(), CV_32FC1, cv::Scalar(100.0f))};
+  }
+  // Uniform random colour and depth (0.5-4 m): a frame of noise.
+  RgbdImage noise(unsigned seed) {
+    cv::RNG rng(seed);
+    RgbdImage img{cv::Mat(frame(0).rgb.size(), CV_8UC3), cv::Mat(frame(0).depth.size(), CV_32FC1)};
+    rng.fill(img.rgb, cv::RNG::UNIFORM, 0, 256);
+    rng.fill(img.depth, cv::RNG::UNIFORM, 0.5, 4.0);
+    return img;
+  }
+
+  // Waits for a warning or error on /rosout, logged after `since`, that contains `text`.
+  std::optional<std::string> waitLog(const std::string& text, const ros::WallTime& since,
+                                     double timeout = 5.0) {
+    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(timeout);
+    while (true) {
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        for (const auto& [wall, msg] : logs_) {
+          if (wall >= since && msg.find(text) != std::string::npos) return msg;
+        }
+      }
+      if (ros::WallTime::now() >= deadline) return std::nullopt;
+      ros::WallDuration(0.02).sleep();
+    }
   }
 
   bool reset() {
@@ -264,7 +310,7 @@ class Client {
   bool late_base_tf_ = false;  // the .test publishes no base transform: the test sends it
   Eigen::Isometry3d base_from_camera_;
   ros::Publisher rgb_pub_, depth_pub_, info_pub_;
-  ros::Subscriber odom_sub_, info_sub_, diag_sub_;
+  ros::Subscriber odom_sub_, info_sub_, diag_sub_, rosout_sub_;
   ros::ServiceClient reset_, reset_to_pose_;
 
  private:
@@ -286,6 +332,11 @@ class Client {
       }
     }
   }
+  void onLog(const rosgraph_msgs::Log& m) {
+    if (m.level < rosgraph_msgs::Log::WARN) return;
+    std::lock_guard<std::mutex> lock(mutex_);
+    logs_.emplace_back(ros::WallTime::now(), m.msg);
+  }
   std::optional<acvo::OdometryInfo> infoAt(const ros::Time& t) {
     std::lock_guard<std::mutex> lock(mutex_);
     auto it = infos_.find(t);
@@ -305,6 +356,7 @@ class Client {
   std::map<ros::Time, nav_msgs::Odometry> odoms_;
   std::map<ros::Time, acvo::OdometryInfo> infos_;
   std::map<ros::Time, int> info_counts_;
+  std::vector<std::pair<ros::WallTime, std::string>> logs_;  // warnings and errors on /rosout
   std::optional<diagnostic_msgs::DiagnosticStatus> last_diag_;
   ros::WallTime last_diag_wall_;
   std::map<int, RgbdImage> frames_;
@@ -462,27 +514,33 @@ TEST(OdometryNodelet, InvalidFramesAreLostThenTrackingResumes) {
   const geometry_msgs::Pose held = good.back().odom->pose.pose;
   const std::uint32_t lost_before = good.back().info->lost_count;
 
-  // Depth all invalid, then a featureless grey image with valid depth.
-  const ros::Time t_blank = client->nextStamp();
-  client->send(client->blank(), t_blank);
-  RgbdImage grey{cv::Mat(client->frame(4).rgb.size(), CV_8UC3, cv::Scalar(128, 128, 128)),
-                 client->frame(4).depth};
-  const ros::Time t_grey = client->nextStamp();
-  client->send(grey, t_grey);
-  Outcome blank = client->outcome(t_blank, true);
-  client->flush();
-  Outcome flat = client->outcome(t_grey, true);
-  for (const Outcome* o : {&blank, &flat}) {
-    ASSERT_TRUE(o->info);
-    EXPECT_TRUE(o->info->lost) << o->info->tracking << ": " << o->info->message;
-    EXPECT_EQ(o->info->tracking, "lost");
-    EXPECT_FALSE(o->info->message.empty());
-    ASSERT_TRUE(o->odom) << "publish_null_when_lost is false: the held pose is published";
-    EXPECT_GE(o->odom->pose.covariance[0], acvo_ros::kLostVariance);
-    EXPECT_GE(o->odom->twist.covariance[35], acvo_ros::kLostVariance);
-    expectPoseNear(o->odom->pose.pose, toEigen(held), 0, "held pose while lost");
+  // Depth all invalid (0 mm in 16UC1, NaN in 32FC1), depth all beyond the range, then a
+  // featureless grey image with valid depth: each lost, the message names the cause.
+  const std::vector<std::pair<RgbdImage, std::string>> invalid = {
+      {client->blank(), "no valid depth"},
+      {client->farDepth(4), "no valid depth"},
+      {client->flatColour(4), "no intensity gradient"}};
+  std::vector<ros::Time> stamps;
+  for (const auto& frame : invalid) {
+    stamps.push_back(client->nextStamp());
+    client->send(frame.first, stamps.back());
   }
-  EXPECT_EQ(flat.info->lost_count, lost_before + 2);
+  client->flush();
+  for (std::size_t i = 0; i < invalid.size(); ++i) {
+    SCOPED_TRACE(invalid[i].second);
+    const Outcome o = client->outcome(stamps[i], true);
+    ASSERT_TRUE(o.info);
+    EXPECT_TRUE(o.info->lost) << o.info->tracking << ": " << o.info->message;
+    EXPECT_EQ(o.info->tracking, "lost");
+    EXPECT_NE(o.info->message.find(invalid[i].second), std::string::npos) << o.info->message;
+    ASSERT_TRUE(o.odom) << "publish_null_when_lost is false: the held pose is published";
+    EXPECT_GE(o.odom->pose.covariance[0], acvo_ros::kLostVariance);
+    EXPECT_GE(o.odom->twist.covariance[35], acvo_ros::kLostVariance);
+    expectPoseNear(o.odom->pose.pose, toEigen(held), 0, "held pose while lost");
+    if (i + 1 == invalid.size()) {
+      EXPECT_EQ(o.info->lost_count, lost_before + invalid.size());
+    }
+  }
   const auto diag = client->waitDiagnostic(diagnostic_msgs::DiagnosticStatus::ERROR, "lost");
   ASSERT_TRUE(diag);
   EXPECT_EQ(diag->level, diagnostic_msgs::DiagnosticStatus::ERROR);
@@ -503,6 +561,161 @@ TEST(OdometryNodelet, InvalidFramesAreLostThenTrackingResumes) {
   const auto ok = client->waitDiagnostic(level, message);
   ASSERT_TRUE(ok);
   EXPECT_EQ(ok->message, message);
+}
+
+// Expected pose of frame k relative to frame j, published in the base frame.
+Eigen::Isometry3d expectedMotion(int j, int k) {
+  return client->expectedBase(cameraPose(j).inverse() * cameraPose(k));
+}
+
+Eigen::Isometry3d relativePose(const Outcome& from, const Outcome& to) {
+  return toEigen(from.odom->pose.pose).inverse() * toEigen(to.odom->pose.pose);
+}
+
+TEST(OdometryNodelet, EveryOtherFrameMissingIsTrackedAndEveryFrameIsPublished) {
+  ASSERT_TRUE(client->reset());
+  // Frames 0, 2, ..., 12 with their stamps: the stamp of each missing frame is skipped, so
+  // each registration spans 0.2 s and twice the motion of a frame (3 cm, 1.2 deg).
+  constexpr int kLast = 12;
+  std::vector<RgbdImage> images;
+  std::vector<ros::Time> stamps;
+  for (int k = 0; k <= kLast; k += 2) {
+    if (k > 0) client->nextStamp();  // the missing frame's
+    images.push_back(client->frame(k));
+    stamps.push_back(client->nextStamp());
+  }
+  const std::vector<Outcome> out = client->run(images, stamps);
+  ASSERT_EQ(out.size(), images.size());
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    SCOPED_TRACE("frame " + std::to_string(2 * i));
+    ASSERT_TRUE(out[i].info) << "no odom_info";
+    ASSERT_TRUE(out[i].odom) << "no odom (" << out[i].info->tracking << ": "
+                             << out[i].info->message << ")";
+    EXPECT_TRUE(i == 0 ? out[i].info->tracking == "first_frame"
+                       : isTracking(out[i].info->tracking))
+        << out[i].info->tracking << ": " << out[i].info->message;
+  }
+  // The budget is per frame of motion (12 frames' worth in 6 registrations).
+  expectPoseNear(out.back().odom->pose.pose, client->expectedBase(cameraPose(kLast)), kLast,
+                 "every other frame missing, final pose");
+}
+
+// One second of blank frames at 10 Hz while the camera moves on (frames 4-13: 15 cm, 6 deg),
+// the first half without valid depth, the second half of one colour; then good frames again.
+TEST(OdometryNodelet, BlackoutOfBlankFramesIsLostNamedThenTrackingResumes) {
+  ASSERT_TRUE(client->reset());
+  constexpr int kBefore = 4, kBlank = 10, kAfter = 8;
+  std::vector<RgbdImage> images;
+  std::vector<ros::Time> stamps;
+  for (int k = 0; k < kBefore + kBlank + kAfter; ++k) {
+    const bool blank = k >= kBefore && k < kBefore + kBlank;
+    images.push_back(!blank ? client->frame(k)
+                     : k < kBefore + kBlank / 2 ? client->blank()
+                                                : client->flatColour(k));
+    stamps.push_back(client->nextStamp());
+  }
+  const std::vector<Outcome> out = client->run(images, stamps);
+  ASSERT_EQ(out.size(), images.size());
+  for (const Outcome& o : out) {
+    ASSERT_TRUE(o.info && o.odom) << "every frame gets odom_info and odom (held while lost)";
+    EXPECT_TRUE(toEigen(o.odom->pose.pose).matrix().allFinite());
+  }
+  for (int k = 1; k < kBefore; ++k) EXPECT_TRUE(isTracking(out[k].info->tracking)) << k;
+  const geometry_msgs::Pose held = out[kBefore - 1].odom->pose.pose;
+  for (int k = kBefore; k < kBefore + kBlank; ++k) {
+    SCOPED_TRACE("blank frame " + std::to_string(k));
+    EXPECT_TRUE(out[k].info->lost);
+    const std::string cause = k < kBefore + kBlank / 2 ? "no valid depth" : "no intensity gradient";
+    EXPECT_NE(out[k].info->message.find(cause), std::string::npos) << out[k].info->message;
+    EXPECT_TRUE(toEigen(out[k].odom->pose.pose).isApprox(toEigen(held), kExact));
+    EXPECT_GE(out[k].odom->pose.covariance[0], acvo_ros::kLostVariance);
+  }
+  // Tracking resumes within two frames of the blackout's end and stays.
+  int resumed = kBefore + kBlank;
+  while (resumed < int(out.size()) && !isTracking(out[resumed].info->tracking)) ++resumed;
+  for (int k = kBefore + kBlank; k < int(out.size()); ++k) {
+    std::cout << "[ MEASURED ] after the blackout, frame " << k << ": " << out[k].info->tracking
+              << " " << out[k].info->message << "\n";
+  }
+  EXPECT_LE(resumed, kBefore + kBlank + 1);
+  for (int k = resumed; k < int(out.size()); ++k) {
+    EXPECT_TRUE(isTracking(out[k].info->tracking))
+        << "frame " << k << ": " << out[k].info->tracking << " " << out[k].info->message;
+  }
+  const int last = int(out.size()) - 1;
+  ASSERT_LT(resumed, last);
+  // From resumption on, the motion is measured as usual.
+  const Eigen::Isometry3d since = relativePose(out[resumed], out[last]);
+  const Eigen::Isometry3d want = expectedMotion(resumed, last);
+  const double since_t = (since.translation() - want.translation()).norm();
+  const double since_r = angleOf(since.rotation().transpose() * want.rotation());
+  std::cout << "[ MEASURED ] blackout: resumed at frame " << resumed << "; from there to frame "
+            << last << ": translation error " << since_t << " m, rotation error " << since_r
+            << " rad\n";
+  EXPECT_LT(since_t, (last - resumed) * kTranslationPerFrame);
+  EXPECT_LT(since_r, (last - resumed) * kRotationPerFrame);
+  // Across the blackout: the motion during it is not observed (the pose is held while lost);
+  // the error is at most that motion plus the drift of the registered frames.
+  const Eigen::Isometry3d across = relativePose(out[kBefore - 1], out[last]);
+  const Eigen::Isometry3d truth = expectedMotion(kBefore - 1, last);
+  const Eigen::Isometry3d unseen = expectedMotion(kBefore - 1, resumed);
+  const double across_t = (across.translation() - truth.translation()).norm();
+  std::cout << "[ MEASURED ] blackout: error from frame " << kBefore - 1 << " to " << last
+            << ": " << across_t << " m (motion from the last good frame to resumption "
+            << unseen.translation().norm() << " m)\n";
+  EXPECT_LT(across_t, unseen.translation().norm() + (last - resumed) * kTranslationPerFrame);
+}
+
+// One frame of noise (random colour and depth) inside a sequence.
+TEST(OdometryNodelet, ASingleFrameOfNoiseIsLostAndTrackingResumes) {
+  ASSERT_TRUE(client->reset());
+  std::vector<RgbdImage> images = {client->frame(0), client->frame(1), client->frame(2),
+                                   client->noise(7), client->frame(4), client->frame(5),
+                                   client->frame(6)};
+  std::vector<ros::Time> stamps;
+  for (std::size_t i = 0; i < images.size(); ++i) stamps.push_back(client->nextStamp());
+  const std::vector<Outcome> out = client->run(images, stamps);
+  for (const Outcome& o : out) ASSERT_TRUE(o.info && o.odom);
+  EXPECT_TRUE(out[3].info->lost) << out[3].info->tracking << ": " << out[3].info->message;
+  EXPECT_FALSE(out[3].info->message.empty());
+  for (std::size_t k = 4; k < out.size(); ++k) {
+    std::cout << "[ MEASURED ] after the noise frame, frame " << k << ": "
+              << out[k].info->tracking << " " << out[k].info->message << "\n";
+  }
+  EXPECT_TRUE(isTracking(out[5].info->tracking)) << out[5].info->message;
+  EXPECT_TRUE(isTracking(out[6].info->tracking)) << out[6].info->message;
+  // Frame 4 is registered against frame 2 (the noise frame did not replace the reference): its
+  // motion spans 0.2 s, and the twist divides it by that, not by the 0.1 s since frame 3.
+  ASSERT_TRUE(isTracking(out[4].info->tracking)) << out[4].info->message;
+  const Eigen::Isometry3d step = client->expectedBase(acvo_test::frameMotion());
+  const auto& twist = out[4].odom->twist.twist.linear;
+  const Eigen::Vector3d v(twist.x, twist.y, twist.z);
+  std::cout << "[ MEASURED ] twist after the noise frame: " << (v - step.translation() / 0.1).norm()
+            << " m/s off\n";
+  EXPECT_LT((v - step.translation() / 0.1).norm(), 0.05) << "m/s";
+  EXPECT_TRUE(toEigen(out.back().odom->pose.pose).matrix().allFinite());
+}
+
+// A pause of 3 s between two frames (max_time_gap 1 s): warned about, the frame after it is
+// processed. The motion prior is one frame's motion (per frame, not per second), and the
+// camera moved one frame's worth during the pause here: tracking goes on.
+TEST(OdometryNodelet, ALargeStampGapIsWarnedAndProcessingContinues) {
+  ASSERT_TRUE(client->reset());
+  std::vector<Outcome> before = client->run(range(0, 4));
+  ASSERT_TRUE(before.back().odom);
+  const ros::WallTime since = ros::WallTime::now();
+  client->skipTime(3.0);
+  std::vector<Outcome> after = client->run(range(4, 7));
+  for (const Outcome& o : after) {
+    ASSERT_TRUE(o.info && o.odom) << "a frame after the gap was not published";
+    EXPECT_TRUE(isTracking(o.info->tracking)) << o.info->tracking << ": " << o.info->message;
+  }
+  const auto warning = client->waitLog("between frames", since);
+  ASSERT_TRUE(warning) << "no warning about the gap on /rosout";
+  EXPECT_NE(warning->find("max_time_gap"), std::string::npos) << *warning;
+  std::cout << "[ MEASURED ] gap warning: " << *warning << "\n";
+  expectPoseNear(after.back().odom->pose.pose, client->expectedBase(cameraPose(6)), 6,
+                 "3 frames after a 3 s gap");
 }
 
 TEST(OdometryNodelet, BadInputIsNamedAndSkippedAndTheNodeCarriesOn) {
@@ -577,16 +790,28 @@ TEST(OdometryNodelet, StampsRepeatedAreDroppedAndAJumpBackRestarts) {
   client->send(client->frame(3), later);
   ASSERT_TRUE(client->outcome(later, true).odom);
   EXPECT_EQ(client->infoCount(stamps.back()), 1) << "a repeated stamp was processed";
+  // A stamp a little before the last one (reordered): dropped too, with a warning.
+  const ros::Time earlier = later - ros::Duration(0.05);
+  const ros::WallTime since = ros::WallTime::now();
+  client->send(client->frame(4), earlier);
+  const ros::Time after = client->nextStamp();
+  client->send(client->frame(4), after);
+  ASSERT_TRUE(client->outcome(after, true).odom);
+  EXPECT_EQ(client->infoCount(earlier), 0) << "a stamp before the last one was processed";
+  // (The warning is throttled: the one for the repeat above or this one.)
+  EXPECT_TRUE(client->waitLog("is not after the last one", since - ros::WallDuration(10.0)));
   // A stamp 5 s in the past: a restarted bag; odometry starts again at identity. (Off the
   // 0.1 s grid of the stamps sent so far, so that its odom_info cannot be confused with an
   // earlier frame's.)
-  const ros::Time back = later - ros::Duration(5.05);
+  const ros::Time back = after - ros::Duration(5.05);
+  const ros::WallTime before_jump = ros::WallTime::now();
   client->send(client->frame(4), back);
   const Outcome restarted = client->outcome(back, true);
   ASSERT_TRUE(restarted.info);
   EXPECT_EQ(restarted.info->tracking, "first_frame");
   ASSERT_TRUE(restarted.odom);
   expectPoseNear(restarted.odom->pose.pose, Eigen::Isometry3d::Identity(), 0, "after jump back");
+  EXPECT_TRUE(client->waitLog("time jumped back", before_jump)) << "no warning on /rosout";
 }
 
 dynamic_reconfigure::Reconfigure::Response reconfigure(const std::string& name, double value,
