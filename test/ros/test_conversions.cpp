@@ -353,6 +353,14 @@ TEST(RosParams, ReconfigureRoundTripsAndDescribesEveryParameter) {
   EXPECT_EQ(std::count(d.begin(), d.end(), '='), count);
 }
 
+TEST(RosParams, ReconfigureDefaultsAreTheCoreDefaults) {
+  // rqt_reconfigure shows the .cfg defaults as "default": they must be acvo::Params'.
+  const acvo::Params defaults;
+  const acvo::Params from_cfg = fromConfig(acvo::AcvoConfig::__getDefault__(), defaults);
+  EXPECT_EQ(describeParams(from_cfg), describeParams(defaults));
+  EXPECT_FALSE(acvo::AcvoConfig::__getDefault__().publish_null_when_lost);
+}
+
 TEST(RosParams, EveryReconfigureEnumValueIsAcceptedByTheCore) {
   // The .cfg lists the enum strings; they must be the core's own spellings.
   for (const auto& v : {acvo::EllPolicy::kAdaptive, acvo::EllPolicy::kFixedSchedule}) {
