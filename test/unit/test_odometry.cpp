@@ -26,6 +26,12 @@ double rotationErrorDeg(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) 
   return logSE3(a.inverse() * b).head<3>().norm() * 180.0 / M_PI;
 }
 
+// Starts `odo` at the sequence's first pose and tracks its first `frames` frames.
+void trackFirst(Odometry& odo, const synth::SynthSequence& seq, int frames) {
+  odo.reset(seq.poses()[0]);
+  for (int i = 0; i < frames; ++i) odo.process(seq.frame(i).toFrame());
+}
+
 Frame blankFrame(const Frame& like) {
   Frame f = like;
   f.depth = cv::Mat::zeros(like.depth.size(), CV_32FC1);
@@ -93,9 +99,7 @@ TEST(Odometry, BadFramesAreRejectedWithoutChangingTheState) {
 TEST(Odometry, BlankFramesAreLostKeepThePoseAndTheReference) {
   const auto seq = exactSequence(4);
   Odometry odo;
-  odo.reset(seq.poses()[0]);
-  odo.process(seq.frame(0).toFrame());
-  odo.process(seq.frame(1).toFrame());
+  trackFirst(odo, seq, 2);
   const Eigen::Isometry3d pose1 = odo.pose();
 
   const OdometryResult lost = odo.process(blankFrame(seq.frame(1).toFrame()));
@@ -115,9 +119,7 @@ TEST(Odometry, BlankFramesAreLostKeepThePoseAndTheReference) {
 TEST(Odometry, FlatColourFrameIsLostNamedAndKeepsTheReference) {
   const auto seq = exactSequence(4);
   Odometry odo;
-  odo.reset(seq.poses()[0]);
-  odo.process(seq.frame(0).toFrame());
-  odo.process(seq.frame(1).toFrame());
+  trackFirst(odo, seq, 2);
   const Eigen::Isometry3d pose1 = odo.pose();
 
   Frame flat = seq.frame(2).toFrame();  // valid depth, one colour: no gradient to select
@@ -139,8 +141,7 @@ TEST(Odometry, FlatColourFrameIsLostNamedAndKeepsTheReference) {
 TEST(Odometry, MotionPriorAcrossAStampGapIsOneFramesMotion) {
   const auto seq = exactSequence(5);
   Odometry odo;
-  odo.reset(seq.poses()[0]);
-  for (int i = 0; i < 3; ++i) odo.process(seq.frame(i).toFrame());
+  trackFirst(odo, seq, 3);
   // The stream pauses for 3 s while the camera stands still at frame 2's pose.
   Frame paused = seq.frame(2).toFrame();
   paused.stamp += 3.0;
@@ -167,8 +168,7 @@ TEST(Odometry, MotionPriorAcrossAStampGapIsOneFramesMotion) {
 TEST(Odometry, ASingleFrameOfNoiseIsLostAndTheNextFrameTracksAgainstTheLastGoodOne) {
   const auto seq = exactSequence(6);
   Odometry odo;
-  odo.reset(seq.poses()[0]);
-  for (int i = 0; i < 3; ++i) odo.process(seq.frame(i).toFrame());
+  trackFirst(odo, seq, 3);
   const Eigen::Isometry3d pose2 = odo.pose();
   Frame noise = seq.frame(3).toFrame();
   cv::RNG rng(7);
@@ -194,8 +194,7 @@ TEST(Odometry, ASingleFrameOfNoiseIsLostAndTheNextFrameTracksAgainstTheLastGoodO
 TEST(Odometry, TheSecondLostFrameInARowBecomesTheReference) {
   const auto seq = exactSequence(5);
   Odometry odo;
-  odo.reset(seq.poses()[0]);
-  odo.process(seq.frame(0).toFrame());
+  trackFirst(odo, seq, 1);
   cv::RNG rng(3);
   for (int n = 0; n < 2; ++n) {
     Frame noise = seq.frame(1).toFrame();
