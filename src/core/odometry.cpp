@@ -50,8 +50,8 @@ std::string whyTooFewPoints(const CloudStats& stats, const SelectionParams& p) {
   const int candidates = stats.selection.gradient_pixels + stats.selection.canny_pixels;
   if (candidates == 0) return "no intensity gradient anywhere in the colour image";
   std::ostringstream why;
-  why << "no valid depth in [" << p.min_depth << ", " << p.max_depth << "] m at its "
-      << candidates << " candidate pixels";
+  why << "no valid depth in [" << p.min_depth << ", " << p.max_depth << "] m at its " << candidates
+      << " candidate pixels";
   return why.str();
 }
 

@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "acvo/odometry.hpp"
-#include "tool_support.hpp"
 #include "synth/sequence.hpp"
+#include "tool_support.hpp"
 
 namespace {
 
@@ -235,7 +235,8 @@ int run(const Arguments& args) {
     std::printf("RSS growth: n/a (needs more than %d frames)\n", kWarmup + kSampleEvery);
   }
   std::printf("Odometry::process: median %.1f ms, p90 %.1f ms, max %.1f ms per frame\n",
-              acvo::tools::percentile(ms, 0.5), acvo::tools::percentile(ms, 0.9), *std::max_element(ms.begin(), ms.end()));
+              acvo::tools::percentile(ms, 0.5), acvo::tools::percentile(ms, 0.9),
+              *std::max_element(ms.begin(), ms.end()));
   std::printf("max |pose translation|: %.3f m; all poses finite: %s\n", max_translation,
               all_finite ? "yes" : "NO");
   return all_finite ? 0 : 1;

@@ -180,9 +180,9 @@ int main(int argc, char** argv) {
               << acvo::toString(s.status) << ',' << r.moving_points << ',' << r.fixed_points << ','
               << s.iterations << ',' << s.ell << ',' << int(s.ell_at_bound) << ',' << s.nnz << ','
               << s.inner_product << ',' << r.cloud_stats.ms_selection << ','
-              << r.cloud_stats.ms_labels << ',' << r.ms_prepare << ',' << r.ms_cloud << ',' << s.ms_neighbours << ','
-              << s.ms_step << ',' << s.ms_ell << ',' << r.ms_registration << ',' << ms << ','
-              << acvo::tools::residentKiB() << '\n';
+              << r.cloud_stats.ms_labels << ',' << r.ms_prepare << ',' << r.ms_cloud << ','
+              << s.ms_neighbours << ',' << s.ms_step << ',' << s.ms_ell << ',' << r.ms_registration
+              << ',' << ms << ',' << acvo::tools::residentKiB() << '\n';
       }
       if (progress) {
         std::fprintf(stderr, "\racvo_tum: frame %ld/%ld  %3d it  %6.1f ms  %s    ", k - first + 1,
@@ -193,7 +193,8 @@ int main(int argc, char** argv) {
     acvo::writeTrajectory(output, trajectory, "acvo trajectory of " + opt.dataset);
     std::printf("wrote %zu poses to %s\n", trajectory.size(), output.c_str());
     std::printf("frames=%zu median_ms=%.3f p90_ms=%.3f failures=%ld\n", trajectory.size(),
-                acvo::tools::percentile(frame_ms, 0.5), acvo::tools::percentile(frame_ms, 0.9), failures);
+                acvo::tools::percentile(frame_ms, 0.5), acvo::tools::percentile(frame_ms, 0.9),
+                failures);
     return 0;
   } catch (const std::exception& e) {
     std::cerr << "acvo_tum: " << e.what() << "\n";

@@ -64,7 +64,6 @@ INSTANTIATE_TEST_SUITE_P(BothPolicies, Registration,
                          ::testing::Values(EllPolicy::kAdaptive, EllPolicy::kFixedSchedule),
                          [](const auto& info) { return toString(info.param); });
 
-
 // The stall rule (SolverParams::stall_iterations) on the case it was made for: a room of flat
 // colours seen by a noisy sensor, where the adaptive length-scale often settles at ell_min and
 // the iterates then circle the optimum without improving the objective. Consecutive frames of
@@ -79,8 +78,8 @@ TEST(StallRule, CutsIterationsOnAnUntexturedRoomWithoutLosingAccuracy) {
   ASSERT_GT(stall_default, 0);
   std::vector<PreparedCloud> clouds;
   for (int i = 0; i < seq.size(); ++i)
-    clouds.push_back(prepareCloud(buildLabelledCloud(seq.frame(i).toFrame(), params.selection),
-                                  params.solver));
+    clouds.push_back(
+        prepareCloud(buildLabelledCloud(seq.frame(i).toFrame(), params.selection), params.solver));
   int iterations[2] = {0, 0}, stalled = 0;
   double sum_mm[2] = {0, 0}, sum_deg[2] = {0, 0};
   for (int i = 1; i + 1 < seq.size(); ++i) {
@@ -109,8 +108,8 @@ TEST(StallRule, CutsIterationsOnAnUntexturedRoomWithoutLosingAccuracy) {
   const int pairs = seq.size() - 2;
   std::printf("  stall off: %d iterations, mean error %.3f mm %.4f deg\n", iterations[0],
               sum_mm[0] / pairs, sum_deg[0] / pairs);
-  std::printf("  stall on:  %d iterations, mean error %.3f mm %.4f deg (%d stopped by the "
-              "rule)\n", iterations[1], sum_mm[1] / pairs, sum_deg[1] / pairs, stalled);
+  std::printf("  stall on:  %d iterations, mean error %.3f mm %.4f deg (%d stopped by the rule)\n",
+              iterations[1], sum_mm[1] / pairs, sum_deg[1] / pairs, stalled);
   // Measured: 1887 -> 1755 iterations, 2.47 -> 2.10 mm, 0.061 -> 0.054 deg, 7 of 39 stopped.
   EXPECT_GE(stalled, 3);
   EXPECT_LT(iterations[1], iterations[0]);
