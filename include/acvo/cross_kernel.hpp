@@ -12,6 +12,7 @@
 
 #include "acvo/kernel.hpp"
 #include "acvo/params.hpp"
+#include "acvo/se3.hpp"
 
 namespace acvo {
 
@@ -21,6 +22,13 @@ struct CrossSums {
   double F = 0.0;         // sum a_ij (the objective, also <f_X, h.f_Z>)
   double F_d2 = 0.0;      // sum a_ij |x_i - y_j|^2 (length-scale gradient term)
   std::int64_t nnz = 0;   // kept pairs
+  std::int64_t matched = 0;  // moving points with at least one kept pair
+  // coarse_to_fine's step: with the kernel values a_ij held fixed, exp(-u) >= exp(-u0)(1 - (u -
+  // u0)) makes sum a_ij u_ij(T) a quadratic whose decrease raises F (a minorise-maximise
+  // step, EM-ICP's). gn_H xi = gn_g are its Gauss-Newton normal equations for a left
+  // perturbation xi = (omega, v) of T.
+  Matrix6d gn_H = Matrix6d::Zero();
+  Vector6d gn_g = Vector6d::Zero();
 };
 
 struct StepSums {
@@ -90,6 +98,11 @@ class CrossKernel {
   SolverParams params_;
   double ell_ = 0.0;
   std::vector<Eigen::Vector3f> y_;  // transformed moving points
+  std::vector<float> scale_;        // per moving point: its length-scale / ell (ellScale)
+  std::vector<float> search_scale_;  // per moving point: its search radius / the unit radius
+  std::vector<float> kappa_;        // per moving point: depth-noise share along its ray
+  float min_scale_ = 1.0f;
+  double scale_ell_ = -1.0;         // the ell scale_ was computed for
   std::vector<Chunk> chunks_;
   CrossSums sums_;
   // Candidate lists stay valid while every moving point stays within list_radius_ - r of where

@@ -2,6 +2,7 @@
 // a uniform voxel grid for the cross-pair search and the self-kernel pairs (method.md §2, §4).
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -62,6 +63,7 @@ struct PreparedCloud {
   LabelledCloud cloud;
   VoxelGrid grid;                 // cell = the search radius at the largest length-scale
   VoxelGrid coarse_grid;          // cell = the search radius at the coarse stage's length-scale
+  std::vector<VoxelGrid> level_grids;  // coarse_to_fine: one grid per level (levelElls)
   std::vector<SelfPair> self_pairs;  // all pairs within that radius that can pass the threshold
   // The same pairs' d2 and colour factors as arrays, for vectorised sums per iteration.
   Eigen::ArrayXf self_d2, self_color;
@@ -70,8 +72,28 @@ struct PreparedCloud {
   std::size_t size() const { return cloud.size(); }
 };
 
+// Whether the kernel is shaped per point (coarse_to_fine with ell_depth_reference or
+// depth_noise set).
+inline bool perPointKernel(const SolverParams& p) {
+  return p.ell_policy == EllPolicy::kCoarseToFine &&
+         (p.ell_depth_reference > 0.0 || p.depth_noise > 0.0);
+}
+// Range-dependent length-scale (SolverParams::ell_depth_reference): a point at depth z uses
+// ell * ellScale(z), z / reference clamped to [kMinEllScale, kMaxEllScale]; 1 when off.
+constexpr float kMinEllScale = 0.5f, kMaxEllScale = 3.0f;
+inline float ellScale(float z, const SolverParams& p) {
+  if (!(p.ell_policy == EllPolicy::kCoarseToFine && p.ell_depth_reference > 0.0)) return 1.0f;
+  const float s = z / float(p.ell_depth_reference);
+  return s < kMinEllScale ? kMinEllScale : (s > kMaxEllScale ? kMaxEllScale : s);
+}
+// The largest factor by which a point's search radius may exceed the unit radius.
+inline float maxEllScale(const SolverParams& p) { return perPointKernel(p) ? kMaxEllScale : 1.0f; }
+
 // The largest spatial length-scale the solver's main stage may use with these parameters.
 double largestEll(const SolverParams& params);
+// The length-scales of the coarse_to_fine levels: ell_init, ell_init * ell_reduction, ... down
+// to ell_min (always the last).
+std::vector<double> levelElls(const SolverParams& params);
 // Cell of a search grid serving radii up to that of length-scale `ell`.
 float gridCell(double ell, const SolverParams& params);
 

@@ -27,9 +27,9 @@ struct OdometryResult {
   Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
   // Covariance of the relative motion `motion` for a left perturbation motion -> exp(xi^) motion,
   // xi = (rotation x y z, translation x y z), expressed in the previous camera's frame; rad^2 and
-  // m^2. Model: covariance_scale * (nnz / moving points) * (-H)^-1 with H the curvature of the
-  // objective at the optimum (SolverResult::hessian); multiplied by 10 when tracking is hard;
-  // 1e6 on the diagonal when lost.
+  // m^2. Model: covariance_scale * (-H)^-1 with H the curvature of the objective at the optimum
+  // (SolverResult::hessian; the paper's policies also multiply by nnz / moving points);
+  // multiplied by 10 when tracking is hard; 1e6 on the diagonal when lost.
   Eigen::Matrix<double, 6, 6> motion_covariance = Eigen::Matrix<double, 6, 6>::Identity();
   SolverResult solver;
   std::size_t fixed_points = 0;
@@ -41,14 +41,16 @@ struct OdometryResult {
 };
 
 // Tracking judgement of a registered frame:
-//  - lost: the solver failed (too few points, not finite), the normalised inner product is below
-//    lost_inner_product, or the motion exceeds max_translation / max_rotation per frame. The pose
-//    is kept and the motion prior is dropped. The reference is re-seeded from this frame,
-//    except from a frame with too few points (blank) and from a first lost frame that has next
-//    to nothing in common with it (inner product below lost_inner_product / 5: noise): then
-//    the next frame is registered against the last good one.
-//  - hard: inner product below hard_inner_product, iteration cap reached, or the length-scale
-//    reached its upper bound at least hard_ell_reductions times (each time the bound shrinks).
+//  - lost: the solver failed (too few points, not finite), fewer than lost_matched_fraction of
+//    the frame's points found a kernel partner (nothing in common: noise, another view), or the
+//    motion exceeds max_translation / max_rotation per frame. A low overlap alone is not lost:
+//    a fast motion registered from the part of the view it keeps is kept. The pose is kept and
+//    the motion prior is dropped. The reference is re-seeded from this frame, except from a
+//    frame with too few points (blank) and from a first lost frame that has next to nothing in
+//    common with it (matched below lost_matched_fraction / 5: noise): then the next frame is
+//    registered against the last good one.
+//  - hard: matched below hard_matched_fraction, iteration cap reached, or (adaptive policy)
+//    the length-scale reached its upper bound at least hard_ell_reductions times.
 //  - ok otherwise.
 class Odometry {
  public:

@@ -1,39 +1,47 @@
-// Every parameter of the method in one struct, with the paper's defaults (method.md §6).
-// One table (visitParams) names each field once; the YAML loader, the ROS parameter loader
-// and the documentation all walk that table.
+// Every parameter of the method in one struct. The defaults are the ones measured best on real
+// Kinect frames (config/acvo.yaml says how); paperParams() gives the paper's A-CVO
+// (config/paper.yaml). One table (visitParams) names each field once; the YAML loader, the ROS
+// parameter loader and the documentation all walk that table.
 #pragma once
 
 #include <string>
 
 namespace acvo {
 
-enum class EllPolicy { kAdaptive, kFixedSchedule };
+enum class EllPolicy { kAdaptive, kFixedSchedule, kCoarseToFine };
 enum class EllUpdate { kDescent, kReference };
 enum class InitialGuess { kConstantVelocity, kIdentity };
 enum class SearchDirection { kConjugateGradient, kGradient };
 
 struct SelectionParams {
-  int target_points = 3000;  // semi-dense cloud size the selector aims at
+  int target_points = 4000;  // semi-dense cloud size the selector aims at (paper: 3000)
   double min_depth = 0.1;    // m; points outside [min_depth, max_depth] are dropped
-  double max_depth = 6.0;    // m
+  double max_depth = 4.0;    // m (paper: 6; Kinect depth beyond 4 m is too coarse to help)
   bool canny_fallback = true;  // add Canny edge pixels when fewer than target/3 were selected
 };
 
 struct SolverParams {
-  EllPolicy ell_policy = EllPolicy::kAdaptive;  // adaptive (A-CVO) or fixed_schedule (CVO)
+  // coarse_to_fine (not in the paper, the default: see alignLevels in solver.cpp), adaptive
+  // (A-CVO) or fixed_schedule (CVO).
+  EllPolicy ell_policy = EllPolicy::kCoarseToFine;
   EllUpdate ell_update = EllUpdate::kDescent;   // descent (paper) or reference (authors' code)
   // Direction of each iteration: the gradient (paper) or nonlinear conjugate gradient
   // (Polak-Ribiere+, not in the paper; measured: 2.5-3x fewer iterations, see config/acvo.yaml).
   SearchDirection direction = SearchDirection::kConjugateGradient;
-  double ell_init = 0.1;        // m, initial spatial length-scale (reset per frame)
-  double ell_min = 0.0391;      // m
+  // m, initial spatial length-scale (reset per frame); coarse_to_fine: its first level
+  double ell_init = 0.04;
+  double ell_min = 0.0045;      // m; coarse_to_fine: its last level (paper: 0.0391)
   double ell_max = 0.15;        // m (only shrinks within a frame, reset per frame)
   double ell_step = 0.3;        // gamma_l, step of the length-scale update
-  double ell_reduction = 0.7;   // lambda_l, factor applied to ell_max when ell reaches it
+  // lambda_l, factor applied to ell_max when ell reaches it (paper: 0.7); coarse_to_fine: the
+  // ratio of one level's length-scale to the previous one's
+  double ell_reduction = 0.25;
   double sigma = 0.1;           // spatial signal std
   double color_ell = 0.1;       // colour length-scale (paper 0.1; measured, see config/acvo.yaml)
   double color_sigma = 1.0;     // colour signal std
-  double sparsification = 8.315e-3;  // a_ij below this are dropped
+  // a_ij below this are dropped. Paper: 8.315e-3 = 0.83 sigma^2, which keeps only pairs within
+  // 0.61 ell (a flat-topped kernel); 1.1e-4 = sigma^2 exp(-4.5) keeps the Gaussian to 3 ell.
+  double sparsification = 1.1e-4;
   double eps_transform = 1e-5;  // stop when t*|xi| < eps_transform
   double eps_gradient = 5e-5;   // stop when |omega| < eps and |v| < eps
   double min_step = 0.2;        // step when the cubic has no positive root
@@ -52,21 +60,33 @@ struct SolverParams {
   int coarse_points = 500;      // moving points used by the coarse stage (evenly strided)
   int coarse_iterations = 20;   // iteration cap of the coarse stage
   int min_points = 30;          // fewer points in either cloud -> status too_few_points
+  // coarse_to_fine only (see config/acvo.yaml for the measurements):
+  // Range-dependent length-scale: a point at depth z uses ell * z / ell_depth_reference (the
+  // factor clamped to [0.5, 3]), so that the kernel spans the same pixels near and far. 0 = off.
+  double ell_depth_reference = 1.0;  // m
+  // Depth noise sigma_z = depth_noise * z^2 (Kinect-like; both points' share): the kernel is
+  // stretched along the viewing ray by it, so that depth noise does not outweigh the lateral
+  // position of a point. 0 = isotropic.
+  double depth_noise = 0.0025;  // 1/m
+  int level_points = 200;       // moving points at the first level (x ell_init / ell after)
+  int level_iterations = 10;    // Gauss-Newton iterations per level, at most
+  double level_eps = 2e-4;      // next level when an iteration moves less (rad and m)
 };
 
 struct OdometryParams {
   InitialGuess initial_guess = InitialGuess::kConstantVelocity;
   int threads = 0;  // 0 = all cores
-  // Tracking judgement (see odometry.hpp): lost below this normalised inner product, or when a
-  // frame-to-frame motion exceeds the limits below; hard to track below hard_inner_product.
-  double lost_inner_product = 0.05;
-  double hard_inner_product = 0.15;
+  // Tracking judgement (see odometry.hpp): lost when fewer than this fraction of the frame's
+  // points found a kernel partner at the solution (nothing in common), or when a frame-to-frame
+  // motion exceeds the limits below; hard to track below hard_matched_fraction.
+  double lost_matched_fraction = 0.02;
+  double hard_matched_fraction = 0.25;
   double max_translation = 0.3;   // m per frame
   double max_rotation = 20.0;     // deg per frame
   int hard_ell_reductions = 3;    // hard to track when ell_max was reduced this often in a frame
   // Relative-motion covariance = covariance_scale * (pairs per point) * (-H)^-1, H the curvature
   // of the objective at the optimum; see odometry.hpp (calibration in config/acvo.yaml).
-  double covariance_scale = 6e-4;
+  double covariance_scale = 3e-7;
 };
 
 struct Params {
@@ -117,15 +137,26 @@ void visitParams(Params_& p, Visitor&& visit) {
   visit("solver", "coarse_points", p.solver.coarse_points);
   visit("solver", "coarse_iterations", p.solver.coarse_iterations);
   visit("solver", "min_points", p.solver.min_points);
+  visit("solver", "ell_depth_reference", p.solver.ell_depth_reference);
+  visit("solver", "depth_noise", p.solver.depth_noise);
+  visit("solver", "level_points", p.solver.level_points);
+  visit("solver", "level_iterations", p.solver.level_iterations);
+  visit("solver", "level_eps", p.solver.level_eps);
   visit("odometry", "initial_guess", p.odometry.initial_guess);
   visit("odometry", "threads", p.odometry.threads);
-  visit("odometry", "lost_inner_product", p.odometry.lost_inner_product);
-  visit("odometry", "hard_inner_product", p.odometry.hard_inner_product);
+  visit("odometry", "lost_matched_fraction", p.odometry.lost_matched_fraction);
+  visit("odometry", "hard_matched_fraction", p.odometry.hard_matched_fraction);
   visit("odometry", "max_translation", p.odometry.max_translation);
   visit("odometry", "max_rotation", p.odometry.max_rotation);
   visit("odometry", "hard_ell_reductions", p.odometry.hard_ell_reductions);
   visit("odometry", "covariance_scale", p.odometry.covariance_scale);
 }
+
+// The paper's A-CVO (adaptive length-scale, its table of constants, 3000 points up to 6 m) with
+// this package's speed-ups for it: conjugate-gradient direction, stall rule, coarse stage
+// (config/paper.yaml; set direction: gradient, stall_iterations: 0, coarse_ell: 0 for the
+// paper's letter).
+Params paperParams();
 
 // Empty when the values are consistent; otherwise a message naming the offending parameter.
 std::string validate(const Params& p);

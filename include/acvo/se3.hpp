@@ -8,6 +8,7 @@
 namespace acvo {
 
 using Vector6d = Eigen::Matrix<double, 6, 1>;
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
 
 Eigen::Matrix3d hat(const Eigen::Vector3d& w);
 

@@ -45,6 +45,9 @@ struct SolverResult {
   // for a wider kernel, the sign of weak structure (the paper's "hard to track" signal).
   int ell_max_reductions = 0;
   std::size_t nnz = 0;         // kept cross-kernel entries at the last iteration
+  // Fraction of the moving points with at least one kept pair at the returned transform: how
+  // much of this frame found something to hold on to in the reference.
+  double matched_fraction = 0.0;
   double inner_product = 0.0;  // <f_X, h.f_Z> / (|f_X| |f_Z|), in [0, 1]
   // Curvature of the objective F at the optimum w.r.t. a left perturbation
   // (omega, v) of the transform, 6x6, negative semi-definite at a maximum.

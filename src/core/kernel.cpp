@@ -44,7 +44,17 @@ double spatialRadius2(double ell, double sigma, double threshold) {
 double largestEll(const SolverParams& p) {
   double ell = std::max(p.ell_init, p.ell_max);
   if (p.ell_policy == EllPolicy::kFixedSchedule) ell = std::max(ell, 0.15);
+  if (p.ell_policy == EllPolicy::kCoarseToFine) ell = p.ell_init;
   return ell;
+}
+
+std::vector<double> levelElls(const SolverParams& p) {
+  std::vector<double> ells;
+  for (double ell = p.ell_init; ell > p.ell_min * (1.0 + 1e-9); ell *= p.ell_reduction) {
+    ells.push_back(ell);
+  }
+  ells.push_back(p.ell_min);
+  return ells;
 }
 
 VoxelGrid::VoxelGrid(const std::vector<Eigen::Vector3f>& points, float cell) : cell_(cell) {
@@ -98,16 +108,25 @@ float gridCell(double ell, const SolverParams& p) {
   const double r2 = spatialRadius2(ell, p.sigma, p.sparsification);
   // Cells a little larger than the search radius: the solver's candidate lists carry a margin
   // beyond the radius and a grid only guarantees neighbours within one cell.
-  return std::isfinite(r2) && r2 > 0.0 ? 1.3f * float(std::sqrt(r2)) + 0.002f : 0.1f;
+  return (std::isfinite(r2) && r2 > 0.0 ? 1.3f * float(std::sqrt(r2)) + 0.002f : 0.1f) *
+         maxEllScale(p);
 }
 
 PreparedCloud prepareCloud(LabelledCloud cloud, const SolverParams& p) {
   const auto t0 = std::chrono::steady_clock::now();
   PreparedCloud out;
   out.cloud = std::move(cloud);
-  const double r2 = spatialRadius2(largestEll(p), p.sigma, p.sparsification);
-  out.grid = VoxelGrid(out.cloud.points, gridCell(largestEll(p), p));
-  if (p.coarse_ell > 0.0) out.coarse_grid = VoxelGrid(out.cloud.points, gridCell(p.coarse_ell, p));
+  const bool levels = p.ell_policy == EllPolicy::kCoarseToFine;
+  // Self pairs serve the length-scale update and the inner product at the final length-scale;
+  // coarse_to_fine needs them at its finest level only.
+  const double self_ell = levels ? p.ell_min : largestEll(p);
+  const double r2 = spatialRadius2(self_ell, p.sigma, p.sparsification);
+  out.grid = VoxelGrid(out.cloud.points, gridCell(self_ell, p));
+  if (levels) {
+    for (double ell : levelElls(p)) out.level_grids.emplace_back(out.cloud.points, gridCell(ell, p));
+  } else if (p.coarse_ell > 0.0) {
+    out.coarse_grid = VoxelGrid(out.cloud.points, gridCell(p.coarse_ell, p));
+  }
 
   const float sigma2 = float(p.sigma * p.sigma);
   const float color_sigma2 = float(p.color_sigma * p.color_sigma);

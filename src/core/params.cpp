@@ -19,7 +19,9 @@ struct EnumNames;
 template <>
 struct EnumNames<EllPolicy> {
   static constexpr std::pair<EllPolicy, const char*> table[] = {
-      {EllPolicy::kAdaptive, "adaptive"}, {EllPolicy::kFixedSchedule, "fixed_schedule"}};
+      {EllPolicy::kAdaptive, "adaptive"},
+      {EllPolicy::kFixedSchedule, "fixed_schedule"},
+      {EllPolicy::kCoarseToFine, "coarse_to_fine"}};
 };
 template <>
 struct EnumNames<EllUpdate> {
@@ -157,16 +159,38 @@ std::string validate(const Params& p) {
   check(why, so.coarse_ell >= 0.0, "solver.coarse_ell", "must not be negative (0 = off)");
   check(why, so.coarse_points > 0, "solver.coarse_points", "must be positive");
   check(why, so.coarse_iterations >= 0, "solver.coarse_iterations", "must not be negative");
+  check(why, so.ell_depth_reference >= 0.0, "solver.ell_depth_reference",
+        "must not be negative (0 = off)");
+  check(why, so.depth_noise >= 0.0, "solver.depth_noise", "must not be negative (0 = off)");
+  check(why, so.level_points > 0, "solver.level_points", "must be positive");
+  check(why, so.level_iterations > 0, "solver.level_iterations", "must be positive");
+  check(why, so.level_eps > 0.0, "solver.level_eps", "must be positive");
   const OdometryParams& od = p.odometry;
   check(why, od.threads >= 0, "odometry.threads", "must not be negative (0 = all cores)");
-  check(why, od.lost_inner_product >= 0.0 && od.lost_inner_product <= od.hard_inner_product,
-        "odometry.lost_inner_product", "must lie within [0, hard_inner_product]");
-  check(why, od.hard_inner_product <= 1.0, "odometry.hard_inner_product", "must not exceed 1");
+  check(why, od.lost_matched_fraction >= 0.0 && od.lost_matched_fraction <= od.hard_matched_fraction,
+        "odometry.lost_matched_fraction", "must lie within [0, hard_matched_fraction]");
+  check(why, od.hard_matched_fraction <= 1.0, "odometry.hard_matched_fraction", "must not exceed 1");
   check(why, od.max_translation > 0.0, "odometry.max_translation", "must be positive");
   check(why, od.max_rotation > 0.0, "odometry.max_rotation", "must be positive");
   check(why, od.hard_ell_reductions > 0, "odometry.hard_ell_reductions", "must be positive");
   check(why, od.covariance_scale > 0.0, "odometry.covariance_scale", "must be positive");
   return why.str();
+}
+
+Params paperParams() {
+  Params p;
+  p.selection.target_points = 3000;
+  p.selection.max_depth = 6.0;
+  p.solver.ell_policy = EllPolicy::kAdaptive;
+  p.solver.ell_init = 0.1;
+  p.solver.ell_min = 0.0391;
+  p.solver.ell_reduction = 0.7;
+  p.solver.sparsification = 8.315e-3;
+  p.solver.ell_depth_reference = 0.0;
+  p.solver.depth_noise = 0.0;
+  p.odometry.hard_matched_fraction = 0.05;
+  p.odometry.covariance_scale = 6e-4;
+  return p;
 }
 
 Params parseParams(const std::string& yaml_text, const Params& base,

@@ -4,6 +4,10 @@
 #include <chrono>
 #include <cmath>
 #include <complex>
+#include <memory>
+#include <optional>
+
+#include <Eigen/Cholesky>
 
 #include "acvo/cross_kernel.hpp"
 #include "acvo/se3.hpp"
@@ -126,6 +130,86 @@ Eigen::Isometry3d coarseAlign(const PreparedCloud& fixed, const PreparedCloud& m
   return T;
 }
 
+// Every k-th point of a cloud (k = size / count, at least 1), labels with them.
+PreparedCloud strided(const PreparedCloud& cloud, int count) {
+  PreparedCloud subset;
+  const int n = int(cloud.size());
+  const int stride = std::max(1, n / std::max(count, 1));
+  for (int j = 0; j < n; j += stride) {
+    subset.cloud.points.push_back(cloud.cloud.points[j]);
+    subset.cloud.labels.push_back(cloud.cloud.labels[j]);
+  }
+  return subset;
+}
+
+// One Gauss-Newton step on the minorising quadratic of the last evaluate() (CrossSums::gn_H):
+// the left increment that raises F. Identity when the pairs constrain nothing.
+Eigen::Isometry3d levelStep(const CrossSums& s) {
+  const Eigen::LDLT<Matrix6d> ldlt(s.gn_H);
+  if (ldlt.info() != Eigen::Success || !(s.gn_H.trace() > 0.0)) return Eigen::Isometry3d::Identity();
+  const Vector6d xi = ldlt.solve(s.gn_g);
+  return xi.allFinite() ? expSE3(xi) : Eigen::Isometry3d::Identity();
+}
+
+// coarse_to_fine (not in the paper): a Gaussian kernel with its tails kept (sparsification far
+// below the paper's), maximised by Gauss-Newton steps at each length-scale of levelElls,
+// from the widest (a subset of the moving points) to the narrowest (all of them).
+void alignLevels(const PreparedCloud& fixed, const PreparedCloud& moving, Eigen::Isometry3d T,
+                 const SolverParams& p, SolverResult& result) {
+  const std::vector<double> ells = levelElls(p);
+  const int levels = int(ells.size());
+  std::optional<PreparedCloud> subset;
+  std::unique_ptr<CrossKernel> kernel;
+  result.status = SolverStatus::kConverged;
+  for (int level = 0; level < levels; ++level) {
+    const double ell = ells[level];
+    const bool last = level + 1 == levels;
+    // Pairs per point grow with the kernel's reach: fewer moving points at the wide levels
+    // (level_points at the first, in proportion to 1 / ell after it, all at the last).
+    const int count = int(std::min<double>(moving.size(), p.level_points * ells.front() / ell));
+    const PreparedCloud* points = &moving;
+    if (!last && count < int(moving.size())) {
+      subset = strided(moving, count);
+      points = &*subset;
+    }
+    const VoxelGrid* grid = level < int(fixed.level_grids.size()) ? &fixed.level_grids[level]
+                                                                   : &fixed.grid;
+    kernel = std::make_unique<CrossKernel>(fixed, *points, p, grid);
+    for (int it = 0; it < p.level_iterations; ++it) {
+      const auto t0 = Clock::now();
+      const CrossSums& s = kernel->evaluate(T, ell);
+      result.ms_neighbours += msSince(t0);
+      const Eigen::Isometry3d step = levelStep(s);
+      if (!step.matrix().allFinite()) {
+        result.status = SolverStatus::kNotFinite;
+        return;
+      }
+      T = normalized(step * T);
+      const Vector6d xi = logSE3(step);
+      result.trace.push_back({ell, ell, 1.0, xi.norm(), s.F, s.nnz});
+      ++result.iterations;
+      if (xi.head<3>().norm() < p.level_eps && xi.tail<3>().norm() < p.level_eps) break;
+      if (last && it + 1 == p.level_iterations) result.status = SolverStatus::kMaxIterations;
+    }
+    if (points != &moving) kernel.reset();
+  }
+  result.transform = T;
+  // Final figures on the full cloud at the finest length-scale.
+  if (!kernel) kernel = std::make_unique<CrossKernel>(fixed, moving, p, &fixed.level_grids.back());
+  const CrossSums& s = kernel->evaluate(T, ells.back());
+  result.ell = ells.back();
+  result.nnz = std::size_t(s.nnz);
+  result.matched_fraction = double(s.matched) / double(std::max<std::size_t>(moving.size(), 1));
+  result.objective = s.F;
+  const SelfSums xx = selfKernelSums(fixed, ells.back(), p);
+  const SelfSums yy = selfKernelSums(moving, ells.back(), p);
+  result.inner_product = xx.sum > 0 && yy.sum > 0 ? s.F / std::sqrt(xx.sum * yy.sum) : 0.0;
+  // The information of the minorising quadratic at the optimum (the Gauss-Newton matrix the
+  // steps solve with); the exact curvature of the narrow kernel is no better conditioned.
+  result.hessian = -s.gn_H;
+  result.list_builds = kernel->candidateListBuilds();
+}
+
 }  // namespace
 
 std::string toString(SolverStatus s) {
@@ -165,6 +249,16 @@ SolverResult align(const PreparedCloud& fixed, const PreparedCloud& moving,
   if (!guess.matrix().allFinite()) {
     result.status = SolverStatus::kNotFinite;
     result.transform = Eigen::Isometry3d::Identity();
+    result.ms_total = msSince(t_start);
+    return result;
+  }
+
+  if (p.ell_policy == EllPolicy::kCoarseToFine) {
+    alignLevels(fixed, moving, guess, p, result);
+    if (!result.transform.matrix().allFinite() || result.status == SolverStatus::kNotFinite) {
+      result.status = SolverStatus::kNotFinite;
+      result.transform = guess;
+    }
     result.ms_total = msSince(t_start);
     return result;
   }
@@ -286,6 +380,7 @@ SolverResult align(const PreparedCloud& fixed, const PreparedCloud& moving,
   result.ell = final_ell;
   result.ell_at_bound = adaptive && (ell <= p.ell_min || ell >= ell_max);
   result.nnz = std::size_t(s.nnz);
+  result.matched_fraction = double(s.matched) / double(std::max<std::size_t>(moving.size(), 1));
   result.objective = s.F;
   const SelfSums xx = selfKernelSums(fixed, final_ell, p);
   const SelfSums yy = selfKernelSums(moving, final_ell, p);

@@ -49,6 +49,7 @@ acvo::OdometryInfo toInfoMsg(const acvo::OdometryResult& result, const std_msgs:
   info.moving_points = static_cast<std::uint32_t>(result.moving_points);
   info.nnz = result.solver.nnz;
   info.inner_product = result.solver.inner_product;
+  info.matched_fraction = result.solver.matched_fraction;
   info.ms_cloud = result.ms_cloud;
   info.ms_registration = result.ms_registration;
   info.ms_total = ms_total;

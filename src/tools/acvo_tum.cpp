@@ -136,7 +136,7 @@ int main(int argc, char** argv) {
       stats.open(opt.stats);
       if (!stats) throw std::runtime_error("cannot write " + opt.stats);
       stats << "frame,stamp,tracking,status,points,fixed_points,iterations,ell,ell_at_bound,nnz,"
-               "inner_product,ms_selection,ms_labels,ms_prepare,ms_cloud,ms_neighbours,ms_step,ms_ell,"
+               "inner_product,matched_fraction,ms_selection,ms_labels,ms_prepare,ms_cloud,ms_neighbours,ms_step,ms_ell,"
                "ms_registration,ms_frame,rss_kib\n";
     }
 
@@ -179,7 +179,7 @@ int main(int argc, char** argv) {
         stats << k << ',' << entry.rgb.stamp_text << ',' << acvo::toString(r.tracking) << ','
               << acvo::toString(s.status) << ',' << r.moving_points << ',' << r.fixed_points << ','
               << s.iterations << ',' << s.ell << ',' << int(s.ell_at_bound) << ',' << s.nnz << ','
-              << s.inner_product << ',' << r.cloud_stats.ms_selection << ','
+              << s.inner_product << ',' << s.matched_fraction << ',' << r.cloud_stats.ms_selection << ','
               << r.cloud_stats.ms_labels << ',' << r.ms_prepare << ',' << r.ms_cloud << ','
               << s.ms_neighbours << ',' << s.ms_step << ',' << s.ms_ell << ',' << r.ms_registration
               << ',' << ms << ',' << acvo::tools::residentKiB() << '\n';

@@ -43,7 +43,7 @@ TEST(VoxelGrid, CandidatesContainEveryPointWithinOneCell) {
 }
 
 TEST(CrossKernel, EqualsBruteForceOnRandomClouds) {
-  SolverParams p;
+  SolverParams p = paperParams().solver;
   const LabelledCloud X = test::randomCloud(1500, 1, 0.5f);
   Eigen::Isometry3d motion = expSE3((Vector6d() << 0.02, -0.01, 0.03, 0.02, 0.01, -0.03).finished());
   const LabelledCloud Z = test::transformed(test::randomCloud(1500, 1, 0.5f), motion.inverse());
@@ -63,7 +63,7 @@ TEST(CrossKernel, EqualsBruteForceOnRandomClouds) {
 }
 
 TEST(CrossKernel, KeptEntriesAreAboveTheThreshold) {
-  SolverParams p;
+  SolverParams p = paperParams().solver;
   const LabelledCloud X = test::randomCloud(800, 3, 0.4f);
   const PreparedCloud fx = prepareCloud(X, p), mz = prepareCloud(X, p);
   CrossKernel kernel(fx, mz, p);
@@ -75,7 +75,7 @@ TEST(CrossKernel, KeptEntriesAreAboveTheThreshold) {
 }
 
 TEST(SelfKernel, PairsEqualBruteForce) {
-  SolverParams p;
+  SolverParams p = paperParams().solver;
   const LabelledCloud X = test::randomCloud(1000, 4, 0.4f);
   const PreparedCloud fx = prepareCloud(X, p);
   for (double ell : {0.15, 0.08, 0.04}) {

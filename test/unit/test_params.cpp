@@ -55,9 +55,22 @@ TEST(Params, ConfigFileHoldsEveryKeyWithTheStructDefaults) {
   const Params loaded = loadParams(path);
   const auto got = flatten(loaded);
   const auto want = flatten(Params());
-  ASSERT_EQ(got.size(), 36u);  // every parameter of visitParams
+  ASSERT_EQ(got.size(), 41u);  // every parameter of visitParams
   EXPECT_EQ(got, want);
   // Equal values could also come from keys missing in the file: check each key is written.
+  const YAML::Node file = YAML::LoadFile(path);
+  visitParams(loaded, [&file](const char* section, const char* name, const auto&) {
+    EXPECT_TRUE(file[section] && file[section][name]) << section << "." << name << " missing";
+  });
+}
+
+// The paper's table is one file away: config/paper.yaml is paperParams(), every key written.
+TEST(Params, PaperFileHoldsEveryKeyWithPaperParams) {
+  const std::string path = (test::sourceDir() / "config" / "paper.yaml").string();
+  const Params loaded = loadParams(path);
+  EXPECT_EQ(flatten(loaded), flatten(paperParams()));
+  EXPECT_EQ(loaded.solver.ell_policy, EllPolicy::kAdaptive);
+  EXPECT_DOUBLE_EQ(loaded.solver.sparsification, 8.315e-3);
   const YAML::Node file = YAML::LoadFile(path);
   visitParams(loaded, [&file](const char* section, const char* name, const auto&) {
     EXPECT_TRUE(file[section] && file[section][name]) << section << "." << name << " missing";
@@ -70,8 +83,8 @@ TEST(Params, EveryKeyIsReadIntoItsField) {
     using T = std::decay_t<decltype(field)>;
     std::string value;
     if constexpr (std::is_same_v<T, EllPolicy>) {
-      value = toString(field == EllPolicy::kAdaptive ? EllPolicy::kFixedSchedule
-                                                     : EllPolicy::kAdaptive);
+      value = toString(field == EllPolicy::kCoarseToFine ? EllPolicy::kFixedSchedule
+                                                         : EllPolicy::kCoarseToFine);
     } else if constexpr (std::is_same_v<T, EllUpdate>) {
       value = toString(field == EllUpdate::kDescent ? EllUpdate::kReference : EllUpdate::kDescent);
     } else if constexpr (std::is_same_v<T, SearchDirection>) {

@@ -40,7 +40,8 @@ TEST_P(Registration, RecoversKnownMotionsOfARenderedRoom) {
   const synth::Scene scene = synth::makeScene({true, true, 3});
   synth::RenderOptions ro;  // TUM default camera, noise off
   const Eigen::Isometry3d pose_a = synth::defaultStartPose();
-  Params params;
+  // coarse_to_fine with its own defaults, the paper's policies with the paper's table.
+  Params params = GetParam() == EllPolicy::kCoarseToFine ? Params() : paperParams();
   params.solver.ell_policy = GetParam();
   params.solver.max_iterations = 400;
   const Frame fa = synth::render(scene, pose_a, ro).toFrame();
@@ -60,8 +61,9 @@ TEST_P(Registration, RecoversKnownMotionsOfARenderedRoom) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(BothPolicies, Registration,
-                         ::testing::Values(EllPolicy::kAdaptive, EllPolicy::kFixedSchedule),
+INSTANTIATE_TEST_SUITE_P(EveryPolicy, Registration,
+                         ::testing::Values(EllPolicy::kCoarseToFine, EllPolicy::kAdaptive,
+                                           EllPolicy::kFixedSchedule),
                          [](const auto& info) { return toString(info.param); });
 
 // The stall rule (SolverParams::stall_iterations) on the case it was made for: a room of flat
@@ -73,7 +75,7 @@ TEST(StallRule, CutsIterationsOnAnUntexturedRoomWithoutLosingAccuracy) {
   o.frames = 41;
   o.texture = false;
   const synth::SynthSequence seq(o);
-  Params params;
+  Params params = paperParams();
   const int stall_default = params.solver.stall_iterations;
   ASSERT_GT(stall_default, 0);
   std::vector<PreparedCloud> clouds;

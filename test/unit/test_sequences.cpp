@@ -1,6 +1,8 @@
 // Whole sequences: RPE over 1 s on synthetic 300-frame sequences (Kinect-like noise) in the
-// TUM structure/texture conditions and on the shared real Kinect frames, for both length-scale
-// policies. Bounds are the measured figures with a margin (README, "Accuracy").
+// TUM structure/texture conditions and on the shared real Kinect frames, for the default engine
+// (coarse_to_fine) and the paper's two policies (paperParams()). Bounds are the measured
+// figures with a margin (README, "Accuracy").
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -33,7 +35,7 @@ std::array<PolicyRun, N> runPolicies(const std::array<EllPolicy, N>& policies, i
   std::array<PolicyRun, N> runs;
   std::array<Odometry, N> odo;
   for (std::size_t p = 0; p < N; ++p) {
-    Params params;
+    Params params = policies[p] == EllPolicy::kCoarseToFine ? Params() : paperParams();
     params.solver.ell_policy = policies[p];
     odo[p] = Odometry(params);
     odo[p].reset(groundtruth.front().pose);
@@ -51,11 +53,13 @@ std::array<PolicyRun, N> runPolicies(const std::array<EllPolicy, N>& policies, i
   return runs;
 }
 
+// The default engine, then the paper's adaptive and fixed-schedule policies.
 template <typename FrameAt>
-std::array<PolicyRun, 2> runBoth(int frames, FrameAt frame_at, const Trajectory& groundtruth) {
-  return runPolicies<2>({EllPolicy::kAdaptive, EllPolicy::kFixedSchedule}, frames, frame_at,
-                        groundtruth);
+std::array<PolicyRun, 3> runAll(int frames, FrameAt frame_at, const Trajectory& groundtruth) {
+  return runPolicies<3>({EllPolicy::kCoarseToFine, EllPolicy::kAdaptive, EllPolicy::kFixedSchedule},
+                        frames, frame_at, groundtruth);
 }
+const char* const kRunNames[] = {"coarse_to_fine", "adaptive", "fixed_schedule"};
 
 Trajectory groundtruthOf(const synth::SynthSequence& seq) {
   Trajectory gt;
@@ -69,7 +73,8 @@ Trajectory groundtruthOf(const synth::SynthSequence& seq) {
 
 struct Condition {
   bool structure, texture;
-  double max_trans, max_rot_deg;  // bounds for the adaptive policy (m/s, deg/s)
+  double max_trans, max_rot_deg;  // bounds for the default engine (m/s, deg/s)
+  double paper_trans, paper_rot_deg;  // bounds for the paper's adaptive policy
 };
 
 class Sequences : public ::testing::TestWithParam<Condition> {};
@@ -81,30 +86,38 @@ TEST_P(Sequences, RpeOverOneSecondOnASyntheticSequence) {
   o.texture = c.texture;
   const synth::SynthSequence seq(o);
   const Trajectory gt = groundtruthOf(seq);
-  const auto runs = runBoth(seq.size(), [&](int i) { return seq.frame(i).toFrame(); }, gt);
-  for (int p = 0; p < 2; ++p) {
+  const auto runs = runAll(seq.size(), [&](int i) { return seq.frame(i).toFrame(); }, gt);
+  for (int p = 0; p < 3; ++p) {
     std::printf("  structure %s texture %s %-14s RPE %.4f m/s %.3f deg/s, %d lost\n",
-                c.structure ? "on " : "off", c.texture ? "on " : "off",
-                p == 0 ? "adaptive" : "fixed_schedule", runs[p].rpe.trans.rmse,
-                runs[p].rpe.rot_deg.rmse, runs[p].lost);
+                c.structure ? "on " : "off", c.texture ? "on " : "off", kRunNames[p],
+                runs[p].rpe.trans.rmse, runs[p].rpe.rot_deg.rmse, runs[p].lost);
   }
   EXPECT_EQ(runs[0].lost, 0);
   EXPECT_LT(runs[0].rpe.trans.rmse, c.max_trans);
   EXPECT_LT(runs[0].rpe.rot_deg.rmse, c.max_rot_deg);
+  EXPECT_EQ(runs[1].lost, 0);
+  EXPECT_LT(runs[1].rpe.trans.rmse, c.paper_trans);
+  EXPECT_LT(runs[1].rpe.rot_deg.rmse, c.paper_rot_deg);
   // The adaptive length-scale is what A-CVO adds: it must not do noticeably worse than CVO's
   // schedule. Measured: better in both on the rooms (by 1.5-2x); on the textured plane the two
   // are level (0.0044 vs 0.0045 m/s, 0.166 vs 0.153 deg/s).
-  EXPECT_LE(runs[0].rpe.trans.rmse, 1.15 * runs[1].rpe.trans.rmse);
-  EXPECT_LE(runs[0].rpe.rot_deg.rmse, 1.15 * runs[1].rpe.rot_deg.rmse);
-  RecordProperty("adaptive_rpe_trans", std::to_string(runs[0].rpe.trans.rmse));
-  RecordProperty("fixed_rpe_trans", std::to_string(runs[1].rpe.trans.rmse));
+  EXPECT_LE(runs[1].rpe.trans.rmse, 1.15 * runs[2].rpe.trans.rmse);
+  EXPECT_LE(runs[1].rpe.rot_deg.rmse, 1.15 * runs[2].rpe.rot_deg.rmse);
+  // The default engine is no worse than the paper's on any condition (issue: within 10%).
+  EXPECT_LE(runs[0].rpe.trans.rmse, 1.1 * runs[1].rpe.trans.rmse);
+  EXPECT_LE(runs[0].rpe.rot_deg.rmse, 1.1 * runs[1].rpe.rot_deg.rmse);
+  RecordProperty("default_rpe_trans", std::to_string(runs[0].rpe.trans.rmse));
+  RecordProperty("adaptive_rpe_trans", std::to_string(runs[1].rpe.trans.rmse));
+  RecordProperty("fixed_rpe_trans", std::to_string(runs[2].rpe.trans.rmse));
 }
 
 INSTANTIATE_TEST_SUITE_P(StructureTexture, Sequences,
-                         // Measured (adaptive): 0.0090/0.251, 0.0132/0.381, 0.0044/0.166.
-                         ::testing::Values(Condition{true, true, 0.015, 0.45},
-                                           Condition{true, false, 0.03, 0.8},
-                                           Condition{false, true, 0.01, 0.35}),
+                         // Measured, default engine: 0.0078/0.208, 0.0129/0.300,
+                         // 0.0032/0.174; paper's adaptive: 0.0091/0.245, 0.0133/0.358,
+                         // 0.0044/0.165.
+                         ::testing::Values(Condition{true, true, 0.015, 0.45, 0.015, 0.45},
+                                           Condition{true, false, 0.03, 0.8, 0.03, 0.8},
+                                           Condition{false, true, 0.01, 0.35, 0.01, 0.35}),
                          [](const auto& info) {
                            return std::string("structure_") +
                                   (info.param.structure ? "on" : "off") + "_texture_" +
@@ -118,7 +131,7 @@ TEST(Sequences, NothingToTrackIsLostAndNeverWorseThanStandingStill) {
   o.texture = false;  // a flat, uniformly coloured plane fills the view
   const synth::SynthSequence seq(o);
   const Trajectory gt = groundtruthOf(seq);
-  const auto runs = runBoth(seq.size(), [&](int i) { return seq.frame(i).toFrame(); }, gt);
+  const auto runs = runAll(seq.size(), [&](int i) { return seq.frame(i).toFrame(); }, gt);
   Trajectory still = gt;
   for (auto& p : still) p.pose = gt.front().pose;
   const RpeResult zero = computeRpe(gt, still);
@@ -157,7 +170,7 @@ TEST(Sequences, EveryOtherFrameMissingStillTracks) {
   const Trajectory all = groundtruthOf(seq);
   Trajectory gt;  // the frames that arrive: 15 Hz, twice the motion per registration
   for (int i = 0; i < seq.size(); i += 2) gt.push_back(all[i]);
-  const PolicyRun run = runPolicies<1>({EllPolicy::kAdaptive}, int(gt.size()),
+  const PolicyRun run = runPolicies<1>({EllPolicy::kCoarseToFine}, int(gt.size()),
                                        [&](int i) { return seq.frame(2 * i).toFrame(); }, gt)[0];
   std::printf("  every other frame missing: RPE %.4f m/s %.3f deg/s (%zu pairs), %d lost\n",
               run.rpe.trans.rmse, run.rpe.rot_deg.rmse, run.rpe.pairs, run.lost);
@@ -188,7 +201,7 @@ void runBlackout(Blank kind) {
     return f;
   };
   const PolicyRun run =
-      runPolicies<1>({EllPolicy::kAdaptive}, kFrames, frame_at, gt)[0];
+      runPolicies<1>({EllPolicy::kCoarseToFine}, kFrames, frame_at, gt)[0];
   const Trajectory& est = run.estimate;
   EXPECT_TRUE(allFinite(est));
   for (int i = 0; i < kStart; ++i) EXPECT_NE(run.tracking[i], Tracking::kLost) << "frame " << i;
@@ -251,17 +264,81 @@ TEST(Sequences, RpeOnRealKinectFrames) {
     gt.push_back({e.stamp_text, e.stamp, (*data.groundtruth())[i].pose});
   }
   const auto runs =
-      runBoth(int(data.size()), [&](int i) { return data.loadFrame(std::size_t(i)); }, gt);
-  for (int p = 0; p < 2; ++p) {
-    std::printf("  kitchen7s_dev %-14s RPE %.4f m/s %.3f deg/s, %d lost\n",
-                p == 0 ? "adaptive" : "fixed_schedule", runs[p].rpe.trans.rmse,
-                runs[p].rpe.rot_deg.rmse, runs[p].lost);
+      runAll(int(data.size()), [&](int i) { return data.loadFrame(std::size_t(i)); }, gt);
+  for (int p = 0; p < 3; ++p) {
+    std::printf("  kitchen7s_dev %-14s RPE %.4f m/s %.3f deg/s, %d lost\n", kRunNames[p],
+                runs[p].rpe.trans.rmse, runs[p].rpe.rot_deg.rmse, runs[p].lost);
   }
-  // Measured 0.060 m/s, 4.40 deg/s (adaptive). 7-Scenes colour and depth come from two
-  // unregistered cameras: the labels sit beside their points, which costs accuracy here.
+  // Measured 0.0336 m/s, 3.51 deg/s (default), 0.060 m/s, 4.40 deg/s (paper's adaptive).
+  // 7-Scenes colour and depth come from two unregistered cameras: the labels sit beside their
+  // points, which costs accuracy here.
   EXPECT_EQ(runs[0].lost, 0);
-  EXPECT_LT(runs[0].rpe.trans.rmse, 0.08);
-  EXPECT_LT(runs[0].rpe.rot_deg.rmse, 5.5);
+  EXPECT_LT(runs[0].rpe.trans.rmse, 0.036);
+  EXPECT_LT(runs[0].rpe.rot_deg.rmse, 3.9);
+  EXPECT_EQ(runs[1].lost, 0);
+  EXPECT_LT(runs[1].rpe.trans.rmse, 0.08);
+  EXPECT_LT(runs[1].rpe.rot_deg.rmse, 5.5);
+}
+
+// TUM fr3/teddy (200 frames, hand-held, up to 100 deg/s) with motion-capture ground truth: the
+// default engine against the bounds OpenCV's RgbdOdometry reaches on the same frames
+// (acvo_compare: 0.0252 m/s, 1.49 deg/s), nothing lost; the paper's A-CVO shrinks the motion
+// there (measured 0.0973 m/s, 7.48 deg/s; docs/accuracy.md).
+TEST(Sequences, RealHandHeldMotionMatchesDenseRgbdOdometry) {
+  const auto shared = test::sharedDataDir();
+  if (shared.empty()) GTEST_SKIP() << "../shared/data not present";
+  const TumDataset data((shared / "tum_fr3_teddy200").string());
+  ASSERT_TRUE(data.groundtruth());
+  const Trajectory& gt = *data.groundtruth();
+  Odometry odo;
+  // Start at the ground-truth pose nearest the first frame (motion capture runs at 100 Hz).
+  const double t0 = data.frames().front().rgb.stamp;
+  const auto nearest = std::min_element(gt.begin(), gt.end(), [t0](const auto& a, const auto& b) {
+    return std::abs(a.stamp - t0) < std::abs(b.stamp - t0);
+  });
+  odo.reset(nearest->pose);
+  Trajectory est;
+  int lost = 0;
+  for (std::size_t i = 0; i < data.size(); ++i) {
+    const OdometryResult r = odo.process(data.loadFrame(i));
+    lost += r.tracking == Tracking::kLost;
+    const auto& e = data.frames()[i].rgb;
+    est.push_back({e.stamp_text, e.stamp, r.pose});
+  }
+  const RpeResult rpe = computeRpe(gt, est);
+  std::printf("  tum_fr3_teddy200 default RPE %.4f m/s %.3f deg/s, %d lost\n", rpe.trans.rmse,
+              rpe.rot_deg.rmse, lost);
+  // Measured 0.0227 m/s, 1.353 deg/s.
+  EXPECT_EQ(lost, 0);
+  EXPECT_LT(rpe.trans.rmse, 0.0252);
+  EXPECT_LT(rpe.rot_deg.rmse, 1.49);
+}
+
+// Lost means lost: a camera turning at more than 90 deg/s (rotation about each axis in turn,
+// Kinect-like noise) keeps little overlap between frames, yet every frame is registered and
+// kept; the paper's A-CVO judged such frames lost by their low inner product.
+TEST(Sequences, FastRotationIsNeverLost) {
+  synth::SequenceOptions o;
+  o.frames = 90;
+  o.motion = synth::MotionKind::kRpy;
+  o.speed = 1.2;  // rpy: 80 deg/s per unit of speed
+  const synth::SynthSequence seq(o);
+  const Trajectory gt = groundtruthOf(seq);
+  double angle = 0.0;
+  for (int i = 1; i < seq.size(); ++i) angle += trueMotion(gt, i - 1, i).second;
+  const double mean_speed = angle / (seq.stamp(seq.size() - 1) - seq.stamp(0));
+  ASSERT_GE(mean_speed, 90.0);
+  const PolicyRun run = runPolicies<1>({EllPolicy::kCoarseToFine}, seq.size(),
+                                       [&](int i) { return seq.frame(i).toFrame(); }, gt)[0];
+  std::printf("  rotation at %.0f deg/s: RPE %.4f m/s %.3f deg/s, %d lost\n", mean_speed,
+              run.rpe.trans.rmse, run.rpe.rot_deg.rmse, run.lost);
+  EXPECT_EQ(run.lost, 0);
+  for (int i = 1; i < seq.size(); ++i) {
+    EXPECT_NE(run.tracking[std::size_t(i)], Tracking::kLost) << "frame " << i;
+  }
+  // Measured 0.0042 m/s, 0.111 deg/s.
+  EXPECT_LT(run.rpe.trans.rmse, 0.008);
+  EXPECT_LT(run.rpe.rot_deg.rmse, 0.25);
 }
 
 }  // namespace

@@ -64,7 +64,7 @@ Pair offsetPair(unsigned seed, const Vector6d& motion_twist) {
 
 // A sparsification so small that no pair in these clouds is dropped: F is smooth.
 SolverParams denseParams() {
-  SolverParams p;
+  SolverParams p = paperParams().solver;
   p.sparsification = 1e-30;
   return p;
 }
@@ -175,7 +175,7 @@ TEST(ConjugateDirection, PolakRibierePlusWithRestarts) {
 
 // ---- whole registrations ------------------------------------------------------------------------
 TEST(Align, IdenticalCloudsGiveIdentityInZeroIterations) {
-  SolverParams p;
+  SolverParams p = paperParams().solver;
   const LabelledCloud X = test::randomCloud(1500, 21, 0.5f);
   const PreparedCloud fx = prepareCloud(X, p), mz = prepareCloud(X, p);
   const CrossSums s = CrossKernel(fx, mz, p).evaluate(Eigen::Isometry3d::Identity(), 0.1);
@@ -198,7 +198,7 @@ TEST(Align, RecoversSmallMotionsOfARandomSurfaceCloud) {
       (Vector6d() << 0.03, 0.02, -0.04, -0.03, 0.02, 0.025).finished(),  // both
   };
   for (EllPolicy policy : {EllPolicy::kAdaptive, EllPolicy::kFixedSchedule}) {
-    SolverParams p;
+    SolverParams p = paperParams().solver;
     p.ell_policy = policy;
     p.max_iterations = 500;
     for (const auto& m : motions) {
@@ -219,7 +219,7 @@ TEST(Align, ConjugateGradientReachesTheSameOptimumInFewerIterations) {
   // slab of points (the random cloud's surface is thin in z) plus a rotation about its normal.
   const Vector6d m = (Vector6d() << 0.0, 0.0, 0.04, 0.04, -0.03, 0.0).finished();
   const Eigen::Isometry3d truth = expSE3(m);
-  SolverParams p;
+  SolverParams p = paperParams().solver;
   p.max_iterations = 500;
   const LabelledCloud X = test::randomCloud(3000, 41, 0.6f);
   const LabelledCloud Z = test::transformed(X, truth.inverse());
@@ -243,7 +243,7 @@ TEST(Align, ConjugateGradientReachesTheSameOptimumInFewerIterations) {
 }
 
 TEST(Align, LengthScaleStaysWithinBoundsAndEllMaxOnlyShrinks) {
-  SolverParams p;
+  SolverParams p = paperParams().solver;
   p.max_iterations = 300;
   const LabelledCloud X = test::randomCloud(2000, 41, 0.6f);
   const LabelledCloud Z =
@@ -271,7 +271,7 @@ TEST(Align, LengthScaleStaysWithinBoundsAndEllMaxOnlyShrinks) {
 }
 
 TEST(Align, TooFewPointsAndNonFiniteInputGiveAStatusNotNaN) {
-  SolverParams p;
+  SolverParams p = paperParams().solver;
   for (int n : {0, 1, 2}) {
     const PreparedCloud c = prepareCloud(test::randomCloud(n, 5), p);
     const SolverResult r = align(c, c, Eigen::Isometry3d::Identity(), p);
