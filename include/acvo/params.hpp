@@ -86,7 +86,7 @@ struct OdometryParams {
   int hard_ell_reductions = 3;    // hard to track when ell_max was reduced this often in a frame
   // Relative-motion covariance = covariance_scale * (pairs per point) * (-H)^-1, H the curvature
   // of the objective at the optimum; see odometry.hpp (calibration in config/acvo.yaml).
-  double covariance_scale = 3e-7;
+  double covariance_scale = 3.5e-7;
 };
 
 struct Params {
