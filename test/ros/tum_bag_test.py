@@ -1,8 +1,9 @@
 #!/usr/bin/python3
 """The TUM bag path end to end: acvo_synth TUM folder -> scripts/tum_to_bag -> tum_bag.launch
-(rosbag play --clock, record:=...) -> recorded TUM trajectory, compared with the ground truth
-and with the offline runner acvo_tum on the same folder and parameters: the ROS path must give
-the offline result (same frames, same decoding), so any difference is the glue's fault.
+(rosbag play --clock, record:=..., both paths relative to the caller's folder) -> recorded TUM
+trajectory, compared with the ground truth and with the offline runner acvo_tum on the same
+folder and parameters: the ROS path must give the offline result (same frames, same decoding),
+so any difference is the glue's fault.
 
 Run by rostest (tum_bag.test), which provides the master. The estimate starts at identity in
 acvo_odom, so trajectories are compared relative to their first frame.
@@ -114,14 +115,18 @@ class TumBagTest(unittest.TestCase):
                                  "rgb8" if topic.endswith("image_color") else "32FC1")
                 self.assertTrue(msg.header.frame_id.startswith("/openni_"))
 
+        # As the README's recipe runs it: from a shell in the bag's folder, with relative bag and
+        # record paths, which must be taken from there (roslaunch starts its nodes in ~/.ros).
         # A queue large enough for the whole bag: a slow machine processes every frame, late.
         launch = subprocess.run(
-            ["roslaunch", "acvo", "tum_bag.launch", "bag:=" + bag_path, "rviz:=false",
-             "record:=" + estimate_path, "rate:=%g" % rate, "delay:=5", "config:=" + CONFIG,
-             "queue_size:=%d" % (frames + 10), "record_idle_timeout:=5"],
+            ["bash", "-c", 'cd "$0" && exec roslaunch "$@"', work, "acvo", "tum_bag.launch",
+             "bag:=sequence.bag", "rviz:=false", "record:=estimate.txt", "rate:=%g" % rate,
+             "delay:=5", "config:=" + CONFIG, "queue_size:=%d" % (frames + 10),
+             "record_idle_timeout:=5"],
             timeout=300, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
         self.assertTrue(os.path.exists(estimate_path),
-                        "no trajectory recorded; roslaunch said:\n" + launch.stdout[-4000:])
+                        "no trajectory recorded in the folder roslaunch was started in; "
+                        "roslaunch said:\n" + launch.stdout[-4000:])
         estimate = read_trajectory(estimate_path)
         self.assertEqual(len(estimate), frames,
                          "frames missing; roslaunch said:\n" + launch.stdout[-4000:])
