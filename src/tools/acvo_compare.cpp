@@ -117,17 +117,11 @@ Options parseOptions(int argc, char** argv) {
 }
 
 acvo::Params acvoParams(const Options& o) {
-  acvo::Params p = o.config.empty() ? acvo::Params() : acvo::loadParams(o.config);
-  for (const auto& s : o.sets) {
-    const auto dot = s.find('.'), eq = s.find('=');
-    if (dot == std::string::npos || eq == std::string::npos || eq < dot) {
-      usageError("--set expects SECTION.KEY=VALUE, got '" + s + "'");
-    }
-    const std::string yaml =
-        s.substr(0, dot) + ":\n  " + s.substr(dot + 1, eq - dot - 1) + ": " + s.substr(eq + 1);
-    p = acvo::parseParams(yaml, p, "--set " + s);
+  try {
+    return acvo::tools::loadToolParams(o.config, o.sets);
+  } catch (const std::invalid_argument& e) {
+    usageError(e.what());
   }
-  return p;
 }
 
 // One method's run over one dataset.
@@ -201,19 +195,11 @@ Step peerStep(const std::string& method, const acvo::Camera& camera,
   };
 }
 
-// The ground-truth pose nearest in time to `stamp` (within 0.02 s, as TUM associates).
+// The first pose: the ground truth nearest the first frame, identity without one.
 Eigen::Isometry3d startPose(const acvo::TumDataset& data, double stamp) {
-  Eigen::Isometry3d best = Eigen::Isometry3d::Identity();
-  double best_dt = 0.02;
-  if (data.groundtruth()) {
-    for (const auto& p : *data.groundtruth()) {
-      if (std::abs(p.stamp - stamp) < best_dt) {
-        best_dt = std::abs(p.stamp - stamp);
-        best = p.pose;
-      }
-    }
-  }
-  return best;
+  const acvo::StampedPose* p =
+      data.groundtruth() ? acvo::tools::nearestPose(*data.groundtruth(), stamp) : nullptr;
+  return p ? p->pose : Eigen::Isometry3d::Identity();
 }
 
 std::string baseName(std::string path) {
@@ -247,14 +233,15 @@ int main(int argc, char** argv) {
       const Eigen::Isometry3d start = startPose(data, frames.front().stamp);
       for (const auto& method : opt.methods) {
         Run run{baseName(folder), method == "acvo" ? opt.label : method, {}, {}, 0};
-        Step step = method == "acvo" ? acvoStep(params, start)
-                                     : peerStep(method, data.camera(), start);
+        Step step =
+            method == "acvo" ? acvoStep(params, start) : peerStep(method, data.camera(), start);
         for (std::size_t i = 0; i < n; ++i) {
           Eigen::Isometry3d pose;
           const auto t0 = std::chrono::steady_clock::now();
           const bool ok = step(frames[i], pose);
-          const double ms = std::chrono::duration<double, std::milli>(
-                                std::chrono::steady_clock::now() - t0).count();
+          const double ms =
+              std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                  .count();
           if (i > 0) run.ms.push_back(ms);
           if (!ok && i > 0) ++run.lost;
           const auto& entry = data.frames()[i].rgb;

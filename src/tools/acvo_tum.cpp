@@ -90,30 +90,14 @@ Options parseOptions(int argc, char** argv) {
 }
 
 acvo::Params loadParameters(const Options& o) {
-  acvo::Params p = o.config.empty() ? acvo::Params() : acvo::loadParams(o.config);
-  for (const auto& s : o.sets) {
-    const auto dot = s.find('.'), eq = s.find('=');
-    if (dot == std::string::npos || eq == std::string::npos || eq < dot) {
-      usageError("--set expects SECTION.KEY=VALUE, got '" + s + "'");
-    }
-    const std::string yaml =
-        s.substr(0, dot) + ":\n  " + s.substr(dot + 1, eq - dot - 1) + ": " + s.substr(eq + 1);
-    p = acvo::parseParams(yaml, p, "--set " + s);
+  acvo::Params p;
+  try {
+    p = acvo::tools::loadToolParams(o.config, o.sets);
+  } catch (const std::invalid_argument& e) {
+    usageError(e.what());
   }
   if (o.threads >= 0) p.odometry.threads = o.threads;
   return p;
-}
-
-// The ground-truth pose nearest in time to `stamp` (within 0.02 s, as TUM associates).
-const acvo::StampedPose* nearestPose(const acvo::Trajectory& gt, double stamp) {
-  const acvo::StampedPose* best = nullptr;
-  for (const auto& p : gt) {
-    if (std::abs(p.stamp - stamp) < 0.02 &&
-        (!best || std::abs(p.stamp - stamp) < std::abs(best->stamp - stamp))) {
-      best = &p;
-    }
-  }
-  return best;
 }
 
 }  // namespace
@@ -144,7 +128,9 @@ int main(int argc, char** argv) {
     Eigen::Isometry3d world_from_first = Eigen::Isometry3d::Identity();
     if (data.groundtruth()) {
       const double stamp = data.frames()[std::size_t(first)].rgb.stamp;
-      if (const auto* p = nearestPose(*data.groundtruth(), stamp)) world_from_first = p->pose;
+      if (const auto* p = acvo::tools::nearestPose(*data.groundtruth(), stamp)) {
+        world_from_first = p->pose;
+      }
     }
     odometry.reset(world_from_first);
 

@@ -19,8 +19,8 @@ namespace fs = std::filesystem;
 
 // Runs a tool of the package with `arguments`, stdout to `output`; returns its exit status.
 int runTool(const std::string& tool, const std::string& arguments, const fs::path& output) {
-  const std::string command = "'" + (test::toolsDir() / tool).string() + "' " + arguments +
-                              " > '" + output.string() + "' 2>/dev/null";
+  const std::string command = "'" + (test::toolsDir() / tool).string() + "' " + arguments + " > '" +
+                              output.string() + "' 2>/dev/null";
   const int status = std::system(command.c_str());
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
@@ -65,9 +65,9 @@ TEST_F(CompareTool, PrintsOneRowPerMethodAndTheJsonBesideIt) {
             0);
   const auto rows = words(out);
   ASSERT_EQ(rows.size(), 5u) << readText(out);
-  const std::vector<std::string> header = {"dataset",  "method", "rpe_t_m/s", "rpe_r_deg/s",
-                                           "ate_m",    "lost",   "median_ms", "p90_ms",
-                                           "vs_rgbd"};
+  const std::vector<std::string> header = {"dataset",     "method", "rpe_t_m/s",
+                                           "rpe_r_deg/s", "ate_m",  "lost",
+                                           "median_ms",   "p90_ms", "vs_rgbd"};
   EXPECT_EQ(rows[0], header);
   const std::vector<std::string> methods = {"acvo", "rgbd", "icp", "rgbd_icp"};
   for (std::size_t k = 0; k < methods.size(); ++k) {
@@ -100,8 +100,7 @@ TEST_F(CompareTool, PrintsOneRowPerMethodAndTheJsonBesideIt) {
 TEST_F(CompareTool, ASubsetOfMethodsAndItsLabel) {
   const fs::path out = dir_ / "subset.txt";
   ASSERT_EQ(runTool("acvo_compare",
-                    "'" + (dir_ / "room").string() +
-                        "' --methods acvo --label paper --config '" +
+                    "'" + (dir_ / "room").string() + "' --methods acvo --label paper --config '" +
                         (test::sourceDir() / "config" / "paper.yaml").string() + "' --frames 20",
                     out),
             0);
