@@ -79,7 +79,7 @@ struct OdometryParams {
   // Tracking judgement (see odometry.hpp): lost when fewer than this fraction of the frame's
   // points found a kernel partner at the solution (nothing in common), or when a frame-to-frame
   // motion exceeds the limits below; hard to track below hard_matched_fraction.
-  double lost_matched_fraction = 0.02;
+  double lost_matched_fraction = 0.1;
   double hard_matched_fraction = 0.25;
   double max_translation = 0.3;   // m per frame
   double max_rotation = 20.0;     // deg per frame

@@ -188,6 +188,7 @@ Params paperParams() {
   p.solver.sparsification = 8.315e-3;
   p.solver.ell_depth_reference = 0.0;
   p.solver.depth_noise = 0.0;
+  p.odometry.lost_matched_fraction = 0.02;
   p.odometry.hard_matched_fraction = 0.05;
   p.odometry.covariance_scale = 6e-4;
   return p;
