@@ -1,15 +1,21 @@
-// Frame-to-frame odometry: owns the previous cloud, builds each cloud once, guesses the
-// motion (constant velocity or identity), registers, composes the pose, judges tracking.
+// The odometry pipeline: owns the keyframe and the last tracked frame, builds each cloud once,
+// guesses the motion (constant velocity, identity or a guess from outside), registers, composes
+// the pose and its covariance, judges tracking, takes keyframes.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <optional>
+#include <string>
 
 #include <Eigen/Geometry>
 
+#include "acvo/covariance.hpp"
 #include "acvo/frame.hpp"
+#include "acvo/kernel.hpp"
 #include "acvo/labelled_cloud.hpp"
 #include "acvo/params.hpp"
+#include "acvo/se3.hpp"
 #include "acvo/solver.hpp"
 
 namespace acvo {
@@ -21,37 +27,78 @@ struct OdometryResult {
   Tracking tracking = Tracking::kBadFrame;
   std::string message;  // why tracking is hard / lost / the frame is bad; empty when ok
   // Camera pose of this frame in the odometry frame (the first frame's camera, or the pose
-  // given to reset()), optical-frame convention.
+  // given to reset()), optical-frame convention. Held (the last tracked pose) when lost.
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  // Motion from this frame's camera to the previous frame's camera (T: current -> previous).
+  // Covariance of `pose` (covariance.hpp: rotation first, left perturbation, odometry-frame
+  // axes): the keyframe's plus this frame's registration to it; grown by lostGrowth while lost.
+  Matrix6d pose_covariance = originCovariance();
+  // Motion from this frame's camera to the last tracked frame's camera (T: current -> last),
+  // over `interval` seconds: what a velocity is made of. Identity when not tracked.
   Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
-  // Covariance of the relative motion `motion` for a left perturbation motion -> exp(xi^) motion,
-  // xi = (rotation x y z, translation x y z), expressed in the previous camera's frame; rad^2 and
-  // m^2. Model: covariance_scale * (-H)^-1 with H the curvature of the objective at the optimum
-  // (SolverResult::hessian; the paper's policies also multiply by nnz / moving points);
-  // multiplied by 10 when tracking is hard; 1e6 on the diagonal when lost.
-  Eigen::Matrix<double, 6, 6> motion_covariance = Eigen::Matrix<double, 6, 6>::Identity();
-  SolverResult solver;
-  std::size_t fixed_points = 0;
+  double interval = 0.0;  // s from the last tracked frame to this one (0: first or bad frame)
+  // Covariance of this frame's registration (T: current -> keyframe, in the keyframe camera's
+  // axes), which is also used for `motion`: covariance_scale * (-H)^-1 (motionCovariance),
+  // times 10 when tracking is hard; kLostVariance on the diagonal when lost.
+  Matrix6d motion_covariance = Matrix6d::Identity();
+  // Frames are numbered from 0 in the order processed (bad frames get no number).
+  std::uint64_t frame_index = 0;
+  std::uint64_t keyframe_index = 0;  // the keyframe this frame was registered to
+  bool new_keyframe = false;         // this frame is the keyframe from now on
+  // Registered to the last tracked frame because the registration to the keyframe failed
+  // (that frame became the keyframe).
+  bool fell_back_to_previous = false;
+  std::shared_ptr<const LabelledCloud> cloud;  // this frame's cloud (null for a bad frame)
+  SolverResult solver;                         // the registration that decided this frame
+  std::size_t fixed_points = 0;                // points of the cloud registered to
   std::size_t moving_points = 0;
   double ms_cloud = 0.0;         // building this frame's cloud (selection + labels + self-kernel)
   double ms_prepare = 0.0;       // of which: search grid + self-kernel pairs
-  double ms_registration = 0.0;  // the solver
+  double ms_registration = 0.0;  // the solver (both registrations when it fell back)
   CloudStats cloud_stats;
 };
 
-// Tracking judgement of a registered frame:
+// Tracking judgement of a registration, from the solver's result and the motion it implies
+// from the last tracked frame (`frame_motion`; the registration's own transform when the frame
+// is registered to the previous one):
 //  - lost: the solver failed (too few points, not finite), fewer than lost_matched_fraction of
 //    the frame's points found a kernel partner (nothing in common: noise, another view), or the
 //    motion exceeds max_translation / max_rotation per frame. A low overlap alone is not lost:
-//    a fast motion registered from the part of the view it keeps is kept. The pose is kept and
-//    the motion prior is dropped. The reference is re-seeded from this frame, except from a
-//    frame with too few points (blank) and from a first lost frame that has next to nothing in
-//    common with it (matched below lost_matched_fraction / 5: noise): then the next frame is
-//    registered against the last good one.
+//    a fast motion registered from the part of the view it keeps is kept.
 //  - hard: matched below hard_matched_fraction, iteration cap reached, or (adaptive policy)
 //    the length-scale reached its upper bound at least hard_ell_reductions times.
 //  - ok otherwise.
+struct Judgement {
+  Tracking tracking = Tracking::kOk;
+  std::string message;  // empty when ok
+};
+Judgement judgeTracking(const SolverResult& s, const Eigen::Isometry3d& frame_motion,
+                        const OdometryParams& params);
+
+// The constant-velocity guess for a frame `interval` seconds after the last tracked frame, from
+// the last motion, measured over `measured` seconds: that motion scaled down in proportion when
+// it spanned clearly more time (< 3/4 of it: a registration across a blackout); never scaled up.
+Eigen::Isometry3d motionPrior(const Eigen::Isometry3d& last, double measured, double interval);
+
+// Whether a frame registered to the keyframe becomes the next keyframe (keyframe reference):
+// hard to track, matched below keyframe_matched_fraction, or moved beyond keyframe_translation
+// / keyframe_rotation from the keyframe.
+bool takesKeyframe(const Judgement& judgement, const SolverResult& s, const OdometryParams& params);
+
+// Whether a lost frame (with `points` points) replaces the keyframe, so that the next frame is
+// registered against it. Never a frame with too few points (blank); always when the keyframe
+// itself has too few. previous_frame: otherwise yes, except a first lost frame with next to
+// nothing in common with the reference (matched below a fifth of lost_matched_fraction: a frame
+// of noise, a glitch). keyframe: from the second lost frame in a row (the view has changed for
+// good); the first is followed by a try against the last good keyframe.
+bool replacesReference(const SolverResult& s, std::size_t points, std::size_t reference_points,
+                       int lost_in_a_row, const Params& params);
+
+// Lost and keyframe handling (see the functions above):
+//  - previous_frame: every tracked frame is the next frame's reference (the paper's driver).
+//  - keyframe: each frame is registered to the keyframe, from the last tracked frame's motion
+//    from it composed with the motion prior; when that fails (lost), to the last tracked frame,
+//    which then becomes the keyframe. A frame that is lost keeps the last good pose (its
+//    covariance grows with lostGrowth) and drops the motion prior.
 class Odometry {
  public:
   explicit Odometry(const Params& params = Params());
@@ -60,25 +107,50 @@ class Odometry {
   Odometry& operator=(Odometry&&) noexcept;
 
   // Processes one frame. A frame with a problem (Frame::problem()) is rejected with
-  // Tracking::kBadFrame and does not change the state.
-  OdometryResult process(const Frame& frame);
+  // Tracking::kBadFrame and does not change the state. `motion_guess`, when given, replaces
+  // the motion prior: the motion from this frame's camera to the last tracked frame's
+  // (T: current -> last, as OdometryResult::motion), e.g. from wheel odometry.
+  OdometryResult process(const Frame& frame,
+                         const std::optional<Eigen::Isometry3d>& motion_guess = std::nullopt);
 
-  // Drops the reference cloud; the next frame starts again from `pose`.
-  void reset(const Eigen::Isometry3d& pose = Eigen::Isometry3d::Identity());
+  // Drops the keyframe; the next frame starts again from `pose`, known to `covariance`.
+  void reset(const Eigen::Isometry3d& pose = Eigen::Isometry3d::Identity(),
+             const Matrix6d& covariance = originCovariance());
 
   const Eigen::Isometry3d& pose() const { return pose_; }
+  const Matrix6d& poseCovariance() const { return pose_covariance_; }
   const Params& params() const { return params_; }
-  // The cloud of the last processed frame (the current reference), if any.
-  const LabelledCloud* lastCloud() const;
+  // The stamp of the last tracked frame: where a motion guess for the next frame starts.
+  std::optional<double> lastTrackedStamp() const;
+  // The current keyframe's cloud, if any.
+  const LabelledCloud* keyframeCloud() const;
 
  private:
+  // A frame with a known pose, kept as the keyframe or as the last tracked frame.
+  struct Tracked {
+    std::shared_ptr<const PreparedCloud> cloud;
+    std::uint64_t index = 0;
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();         // camera in the odometry frame
+    Matrix6d covariance = Matrix6d::Zero();                         // of pose
+    Eigen::Isometry3d to_keyframe = Eigen::Isometry3d::Identity();  // camera -> keyframe camera
+  };
+  struct Registration;
+  Registration registerTo(const Tracked& reference, const PreparedCloud& current,
+                          const Eigen::Isometry3d& guess);
+  void tracked(OdometryResult& r, Registration reg, const std::shared_ptr<PreparedCloud>& current);
+  void lost(OdometryResult& r, const Registration& reg,
+            const std::shared_ptr<PreparedCloud>& current, double stamp);
+
   Params params_;
   Eigen::Isometry3d pose_ = Eigen::Isometry3d::Identity();
-  Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();  // last relative motion
+  Matrix6d pose_covariance_;
+  Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();  // last frame-to-frame motion
   double velocity_interval_ = 0.0;  // s between the two frames of velocity_ (0: unknown)
-  std::optional<PreparedCloud> reference_;
-  bool last_lost_ = false;  // the previous frame was lost (see the judgement above)
-  struct Arena;  // the thread pool the solver runs in (odometry.threads)
+  std::optional<Tracked> keyframe_;
+  std::optional<Tracked> last_;  // the last tracked frame (the keyframe itself, or after it)
+  int lost_in_a_row_ = 0;
+  std::uint64_t frames_ = 0;  // frames numbered so far
+  struct Arena;               // the thread pool the solver runs in (odometry.threads)
   std::unique_ptr<Arena> arena_;
 };
 

@@ -12,6 +12,7 @@ enum class EllPolicy { kAdaptive, kFixedSchedule, kCoarseToFine };
 enum class EllUpdate { kDescent, kReference };
 enum class InitialGuess { kConstantVelocity, kIdentity };
 enum class SearchDirection { kConjugateGradient, kGradient };
+enum class Reference { kKeyframe, kPreviousFrame };
 
 struct SelectionParams {
   int target_points = 4000;  // semi-dense cloud size the selector aims at (paper: 3000)
@@ -75,6 +76,17 @@ struct SolverParams {
 
 struct OdometryParams {
   InitialGuess initial_guess = InitialGuess::kConstantVelocity;
+  // What each frame is registered to (not in the paper, which registers to the previous frame):
+  // a keyframe, kept while the frames still overlap it (a camera that stands still or sways
+  // then collects no drift), or the previous frame. See odometry.hpp.
+  Reference reference = Reference::kPreviousFrame;
+  // keyframe only: a frame registered to the keyframe becomes the next keyframe when fewer
+  // than this fraction of its points found a kernel partner in the keyframe, when its motion
+  // from the keyframe exceeds keyframe_translation or keyframe_rotation, or when it was hard
+  // to track.
+  double keyframe_matched_fraction = 0.5;
+  double keyframe_translation = 0.1;  // m
+  double keyframe_rotation = 5.0;     // deg
   int threads = 0;  // 0 = all cores
   // Tracking judgement (see odometry.hpp): lost when fewer than this fraction of the frame's
   // points found a kernel partner at the solution (nothing in common), or when a frame-to-frame
@@ -87,6 +99,11 @@ struct OdometryParams {
   // Relative-motion covariance = covariance_scale * (pairs per point) * (-H)^-1, H the curvature
   // of the objective at the optimum; see odometry.hpp (calibration in config/acvo.yaml).
   double covariance_scale = 3.5e-7;
+  // While tracking is lost the camera may move unseen: the held pose's covariance grows by
+  // (lost_speed * t)^2 and (lost_angular_speed * t)^2, t the time since the last tracked frame
+  // (a hand-held camera: 0.35 m/s and up to 100 deg/s on TUM fr3/teddy).
+  double lost_speed = 1.0;            // m/s
+  double lost_angular_speed = 90.0;   // deg/s
 };
 
 struct Params {
@@ -99,11 +116,13 @@ std::string toString(EllPolicy v);
 std::string toString(EllUpdate v);
 std::string toString(InitialGuess v);
 std::string toString(SearchDirection v);
+std::string toString(Reference v);
 // Throw std::invalid_argument listing the accepted values.
 void fromString(const std::string& s, EllPolicy& v);
 void fromString(const std::string& s, EllUpdate& v);
 void fromString(const std::string& s, InitialGuess& v);
 void fromString(const std::string& s, SearchDirection& v);
+void fromString(const std::string& s, Reference& v);
 
 // Calls visit(section, name, field) for every parameter; field is int&, double&, bool& or one
 // of the enums above. Sections: "selection", "solver", "odometry".
@@ -144,12 +163,18 @@ void visitParams(Params_& p, Visitor&& visit) {
   visit("solver", "level_eps", p.solver.level_eps);
   visit("odometry", "initial_guess", p.odometry.initial_guess);
   visit("odometry", "threads", p.odometry.threads);
+  visit("odometry", "reference", p.odometry.reference);
+  visit("odometry", "keyframe_matched_fraction", p.odometry.keyframe_matched_fraction);
+  visit("odometry", "keyframe_translation", p.odometry.keyframe_translation);
+  visit("odometry", "keyframe_rotation", p.odometry.keyframe_rotation);
   visit("odometry", "lost_matched_fraction", p.odometry.lost_matched_fraction);
   visit("odometry", "hard_matched_fraction", p.odometry.hard_matched_fraction);
   visit("odometry", "max_translation", p.odometry.max_translation);
   visit("odometry", "max_rotation", p.odometry.max_rotation);
   visit("odometry", "hard_ell_reductions", p.odometry.hard_ell_reductions);
   visit("odometry", "covariance_scale", p.odometry.covariance_scale);
+  visit("odometry", "lost_speed", p.odometry.lost_speed);
+  visit("odometry", "lost_angular_speed", p.odometry.lost_angular_speed);
 }
 
 // The paper's A-CVO (adaptive length-scale, its table of constants, 3000 points up to 6 m) with

@@ -4,42 +4,39 @@
 #include <cmath>
 #include <sstream>
 
-#include <Eigen/Eigenvalues>
 #include <tbb/task_arena.h>
 
-#include "acvo/se3.hpp"
+#include "acvo/covariance.hpp"
 
 namespace acvo {
 
 struct Odometry::Arena {
-  explicit Arena(int threads)
-      : arena(threads > 0 ? threads : tbb::task_arena::automatic) {}
+  explicit Arena(int threads) : arena(threads > 0 ? threads : tbb::task_arena::automatic) {}
   tbb::task_arena arena;
+};
+
+// One registration of the current frame to a reference, judged, with its covariance.
+struct Odometry::Registration {
+  SolverResult solver;
+  Judgement judgement;
+  Matrix6d covariance = lostCovariance();  // of the motion, when tracked
+  std::size_t fixed_points = 0;
 };
 
 std::string toString(Tracking t) {
   switch (t) {
-    case Tracking::kOk: return "ok";
-    case Tracking::kHard: return "hard";
-    case Tracking::kLost: return "lost";
-    case Tracking::kFirstFrame: return "first_frame";
-    case Tracking::kBadFrame: return "bad_frame";
+    case Tracking::kOk:
+      return "ok";
+    case Tracking::kHard:
+      return "hard";
+    case Tracking::kLost:
+      return "lost";
+    case Tracking::kFirstFrame:
+      return "first_frame";
+    case Tracking::kBadFrame:
+      return "bad_frame";
   }
   return "unknown";
-}
-
-Odometry::Odometry(const Params& params)
-    : params_(params), arena_(std::make_unique<Arena>(params.odometry.threads)) {}
-Odometry::~Odometry() = default;
-Odometry::Odometry(Odometry&&) noexcept = default;
-Odometry& Odometry::operator=(Odometry&&) noexcept = default;
-
-void Odometry::reset(const Eigen::Isometry3d& pose) {
-  pose_ = pose;
-  velocity_ = Eigen::Isometry3d::Identity();
-  velocity_interval_ = 0.0;
-  reference_.reset();
-  last_lost_ = false;
 }
 
 namespace {
@@ -55,13 +52,6 @@ std::string whyTooFewPoints(const CloudStats& stats, const SelectionParams& p) {
   return why.str();
 }
 
-// The constant-velocity guess for a frame `interval` seconds after the reference, from the last
-// motion, measured over `measured` seconds: that motion scaled down in proportion when it
-// spanned clearly more time (a registration across a blackout: its whole motion again as the
-// next frame's guess was 0.18 m off and lost that frame); never scaled up (across a pause of
-// seconds the motion is unknown: one frame's motion is a small guess, that motion times the
-// frames the pause spans could be far off). Stamp jitter (below 4/3 of the interval), or no
-// usable stamps: the last motion as it is.
 std::string percent(double fraction) {
   std::ostringstream out;
   out.precision(3);
@@ -69,166 +59,257 @@ std::string percent(double fraction) {
   return out.str();
 }
 
-Eigen::Isometry3d motionPrior(const Eigen::Isometry3d& last, double measured, double interval) {
-  if (!(measured > 0.0) || !(interval > 0.0) || 0.75 * measured <= interval) return last;
-  return expSE3(logSE3(last) * (interval / measured));
+double rotationDeg(const Eigen::Isometry3d& T) {
+  return logSE3(T).head<3>().norm() * 180.0 / M_PI;
 }
 }  // namespace
 
-const LabelledCloud* Odometry::lastCloud() const {
-  return reference_ ? &reference_->cloud : nullptr;
+Judgement judgeTracking(const SolverResult& s, const Eigen::Isometry3d& frame_motion,
+                        const OdometryParams& op) {
+  const double rotation_deg = rotationDeg(frame_motion);
+  const double translation = frame_motion.translation().norm();
+  if (s.status == SolverStatus::kTooFewPoints || s.status == SolverStatus::kNotFinite) {
+    return {Tracking::kLost, "registration failed: " + toString(s.status)};
+  }
+  if (s.matched_fraction < op.lost_matched_fraction) {
+    // Next to no point found a partner: the solver had nothing to hold on to (a frame of noise,
+    // a view with nothing in common). A low overlap alone is not this: a fast motion that
+    // keeps a fifth of the view in common is registered from that fifth and kept.
+    return {Tracking::kLost, "clouds do not overlap (" + percent(s.matched_fraction) +
+                                 " of the points found a partner)"};
+  }
+  if (translation > op.max_translation || rotation_deg > op.max_rotation) {
+    return {Tracking::kLost, "implausible motion (" + std::to_string(translation) + " m, " +
+                                 std::to_string(rotation_deg) + " deg in one frame)"};
+  }
+  if (s.matched_fraction < op.hard_matched_fraction) {
+    return {Tracking::kHard,
+            "weak overlap (" + percent(s.matched_fraction) + " of the points found a partner)"};
+  }
+  if (s.status == SolverStatus::kMaxIterations) return {Tracking::kHard, "iteration cap reached"};
+  if (s.ell_max_reductions >= op.hard_ell_reductions) {
+    return {Tracking::kHard, "length-scale kept reaching its upper bound (" +
+                                 std::to_string(s.ell_max_reductions) +
+                                 " reductions): weak structure"};
+  }
+  return {Tracking::kOk, ""};
 }
 
-OdometryResult Odometry::process(const Frame& frame) {
+Eigen::Isometry3d motionPrior(const Eigen::Isometry3d& last, double measured, double interval) {
+  // A registration across a blackout: its whole motion again as the next frame's guess was
+  // 0.18 m off and lost that frame. Across a pause of seconds the motion is unknown: one
+  // frame's motion is a small guess, that motion times the frames the pause spans could be far
+  // off. Stamp jitter (below 4/3 of the interval), or no usable stamps: the last motion as is.
+  if (!(measured > 0.0) || !(interval > 0.0) || 0.75 * measured <= interval) return last;
+  return expSE3(logSE3(last) * (interval / measured));
+}
+
+bool takesKeyframe(const Judgement& judgement, const SolverResult& s,
+                   const OdometryParams& params) {
+  return judgement.tracking == Tracking::kHard ||
+         s.matched_fraction < params.keyframe_matched_fraction ||
+         s.transform.translation().norm() > params.keyframe_translation ||
+         rotationDeg(s.transform) > params.keyframe_rotation;
+}
+
+bool replacesReference(const SolverResult& s, std::size_t points, std::size_t reference_points,
+                       int lost_in_a_row, const Params& params) {
+  const std::size_t min_points = std::size_t(params.solver.min_points);
+  if (points < min_points) return false;  // a blank frame never replaces the reference
+  if (reference_points < min_points) return true;
+  if (params.odometry.reference == Reference::kKeyframe) return lost_in_a_row >= 2;
+  // Measured (previous_frame): re-seeding from a frame of noise (matched 0) cost the motion of
+  // two frames; frames lost narrowly (kitchen7s_dev with the fixed schedule) do re-seed: the
+  // next frame registered against the older reference was lost more often (15 frames, not 13).
+  const bool failed =
+      s.status == SolverStatus::kTooFewPoints || s.status == SolverStatus::kNotFinite;
+  const bool unrelated =
+      !failed && s.matched_fraction < 0.2 * params.odometry.lost_matched_fraction;
+  return lost_in_a_row >= 2 || !unrelated;
+}
+
+Odometry::Odometry(const Params& params)
+    : params_(params),
+      pose_covariance_(originCovariance()),
+      arena_(std::make_unique<Arena>(params.odometry.threads)) {}
+Odometry::~Odometry() = default;
+Odometry::Odometry(Odometry&&) noexcept = default;
+Odometry& Odometry::operator=(Odometry&&) noexcept = default;
+
+void Odometry::reset(const Eigen::Isometry3d& pose, const Matrix6d& covariance) {
+  pose_ = pose;
+  pose_covariance_ = covariance;
+  velocity_ = Eigen::Isometry3d::Identity();
+  velocity_interval_ = 0.0;
+  keyframe_.reset();
+  last_.reset();
+  lost_in_a_row_ = 0;
+}
+
+std::optional<double> Odometry::lastTrackedStamp() const {
+  if (!last_) return std::nullopt;
+  return last_->cloud->cloud.stamp;
+}
+
+const LabelledCloud* Odometry::keyframeCloud() const {
+  return keyframe_ ? &keyframe_->cloud->cloud : nullptr;
+}
+
+Odometry::Registration Odometry::registerTo(const Tracked& reference, const PreparedCloud& current,
+                                            const Eigen::Isometry3d& guess) {
+  Registration reg;
+  reg.fixed_points = reference.cloud->size();
+  arena_->arena.execute(
+      [&] { reg.solver = align(*reference.cloud, current, guess, params_.solver); });
+  // The motion limits hold per frame: from the last tracked frame, not from an older keyframe.
+  const bool from_last = &reference == &*last_ || last_->index == reference.index;
+  reg.judgement = judgeTracking(
+      reg.solver,
+      from_last ? reg.solver.transform : last_->to_keyframe.inverse() * reg.solver.transform,
+      params_.odometry);
+  const SolverResult& s = reg.solver;
+  if (s.status == SolverStatus::kTooFewPoints || s.status == SolverStatus::kNotFinite) {
+    reg.judgement.message += " (" + std::to_string(reg.fixed_points) + " and " +
+                             std::to_string(current.size()) + " points)";
+  }
+  if (reg.judgement.tracking == Tracking::kLost) return reg;
+
+  const std::optional<Matrix6d> cov =
+      motionCovariance(s, params_.solver, params_.odometry.covariance_scale, current.size());
+  if (!cov) {
+    reg.covariance = lostCovariance();
+    if (reg.judgement.tracking == Tracking::kOk) {
+      reg.judgement = {Tracking::kHard, "motion not constrained in every direction"};
+    }
+  } else {
+    reg.covariance = *cov;
+  }
+  if (reg.judgement.tracking == Tracking::kHard) reg.covariance *= 10.0;
+  return reg;
+}
+
+OdometryResult Odometry::process(const Frame& frame,
+                                 const std::optional<Eigen::Isometry3d>& motion_guess) {
   using Clock = std::chrono::steady_clock;
   OdometryResult r;
   r.pose = pose_;
+  r.pose_covariance = pose_covariance_;
+  r.keyframe_index = keyframe_ ? keyframe_->index : 0;
   if (std::string why = frame.problem(); !why.empty()) {
     r.tracking = Tracking::kBadFrame;
     r.message = why;
-    r.motion_covariance = Eigen::Matrix<double, 6, 6>::Identity() * 1e6;
+    r.motion_covariance = lostCovariance();
     return r;
   }
 
   const auto t0 = Clock::now();
-  std::optional<PreparedCloud> current;
+  std::shared_ptr<PreparedCloud> current;
   arena_->arena.execute([&] {
-    current = prepareCloud(buildLabelledCloud(frame, params_.selection, &r.cloud_stats),
-                           params_.solver);
+    current = std::make_shared<PreparedCloud>(
+        prepareCloud(buildLabelledCloud(frame, params_.selection, &r.cloud_stats), params_.solver));
   });
   r.ms_cloud = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
   r.moving_points = current->size();
   r.ms_prepare = current->ms_prepare;
+  r.cloud = std::shared_ptr<const LabelledCloud>(current, &current->cloud);
+  r.frame_index = frames_++;
 
-  if (!reference_) {
-    last_lost_ = false;
-    reference_ = std::move(current);
+  if (!keyframe_) {
+    lost_in_a_row_ = 0;
+    keyframe_ = last_ =
+        Tracked{current, r.frame_index, pose_, pose_covariance_, Eigen::Isometry3d::Identity()};
     r.tracking = Tracking::kFirstFrame;
-    r.fixed_points = 0;
+    r.keyframe_index = r.frame_index;
+    r.new_keyframe = true;
     return r;
   }
-  r.fixed_points = reference_->size();
 
-  const double interval = frame.stamp - reference_->cloud.stamp;
-  const Eigen::Isometry3d guess = params_.odometry.initial_guess == InitialGuess::kConstantVelocity
-                                      ? motionPrior(velocity_, velocity_interval_, interval)
-                                      : Eigen::Isometry3d::Identity();
-  arena_->arena.execute([&] { r.solver = align(*reference_, *current, guess, params_.solver); });
-  r.ms_registration = r.solver.ms_total;
+  r.interval = frame.stamp - last_->cloud->cloud.stamp;
+  const Eigen::Isometry3d prior =
+      motion_guess ? *motion_guess
+      : params_.odometry.initial_guess == InitialGuess::kConstantVelocity
+          ? motionPrior(velocity_, velocity_interval_, r.interval)
+          : Eigen::Isometry3d::Identity();
+  const bool last_is_keyframe = last_->index == keyframe_->index;
+  // From the keyframe: where the last tracked frame was, then the prior's motion.
+  Registration reg =
+      registerTo(*keyframe_, *current, last_is_keyframe ? prior : last_->to_keyframe * prior);
+  r.ms_registration = reg.solver.ms_total;
 
-  // Judge the result.
-  const auto& op = params_.odometry;
-  const SolverResult& s = r.solver;
-  const Vector6d xi = logSE3(s.transform);
-  const double rotation_deg = xi.head<3>().norm() * 180.0 / M_PI;
-  const double translation = s.transform.translation().norm();
-  const bool too_few = s.status == SolverStatus::kTooFewPoints;
-  if (too_few || s.status == SolverStatus::kNotFinite) {
-    r.tracking = Tracking::kLost;
-    r.message = "registration failed: " + toString(s.status) + " (" +
-                std::to_string(r.fixed_points) + " and " + std::to_string(r.moving_points) +
-                " points)";
-    if (too_few) {
+  // Failed against the keyframe: the last tracked frame, closer in time, may still overlap.
+  if (reg.judgement.tracking == Tracking::kLost && !last_is_keyframe &&
+      int(current->size()) >= params_.solver.min_points) {
+    Registration to_last = registerTo(*last_, *current, prior);
+    r.ms_registration += to_last.solver.ms_total;
+    if (to_last.judgement.tracking != Tracking::kLost) {
+      keyframe_ = last_;
+      keyframe_->to_keyframe = last_->to_keyframe = Eigen::Isometry3d::Identity();
+      reg = std::move(to_last);
+      r.fell_back_to_previous = true;
+    }
+  }
+  r.keyframe_index = keyframe_->index;
+  r.fixed_points = reg.fixed_points;
+  r.solver = reg.solver;
+  r.tracking = reg.judgement.tracking;
+  r.message = reg.judgement.message;
+  if (r.tracking == Tracking::kLost) {
+    if (reg.solver.status == SolverStatus::kTooFewPoints) {
       r.message += int(r.moving_points) < params_.solver.min_points
                        ? ": this frame has " + whyTooFewPoints(r.cloud_stats, params_.selection)
                        : ": the reference frame has too few points";
     }
-  } else if (s.matched_fraction < op.lost_matched_fraction) {
-    // Next to no point found a partner: the solver had nothing to hold on to (a frame of noise,
-    // a view with nothing in common). A low overlap alone is not this: a fast motion that
-    // keeps a fifth of the view in common is registered from that fifth and kept.
-    r.tracking = Tracking::kLost;
-    r.message = "clouds do not overlap (" + percent(s.matched_fraction) +
-                " of the points found a partner)";
-  } else if (translation > op.max_translation || rotation_deg > op.max_rotation) {
-    r.tracking = Tracking::kLost;
-    r.message = "implausible motion (" + std::to_string(translation) + " m, " +
-                std::to_string(rotation_deg) + " deg in one frame)";
-  } else if (s.matched_fraction < op.hard_matched_fraction) {
-    r.tracking = Tracking::kHard;
-    r.message = "weak overlap (" + percent(s.matched_fraction) + " of the points found a partner)";
-  } else if (s.status == SolverStatus::kMaxIterations) {
-    r.tracking = Tracking::kHard;
-    r.message = "iteration cap reached";
-  } else if (s.ell_max_reductions >= op.hard_ell_reductions) {
-    r.tracking = Tracking::kHard;
-    r.message = "length-scale kept reaching its upper bound (" +
-                std::to_string(s.ell_max_reductions) + " reductions): weak structure";
+    lost(r, reg, current, frame.stamp);
   } else {
-    r.tracking = Tracking::kOk;
+    tracked(r, std::move(reg), current);
   }
-
-  if (r.tracking == Tracking::kLost) {
-    // Keep the last good pose; never extrapolate a motion we could not confirm.
-    velocity_ = Eigen::Isometry3d::Identity();
-    velocity_interval_ = 0.0;
-    r.motion = Eigen::Isometry3d::Identity();
-    r.motion_covariance = Eigen::Matrix<double, 6, 6>::Identity() * 1e6;
-    // Re-seed the reference from this frame when it has points enough, except after a tracked
-    // frame when this one has next to nothing in common with the reference (inner product
-    // below a fifth of the lost threshold: noise, a glitch): such a frame must not replace a
-    // good reference, the next frame is registered against the last good one (measured: a
-    // frame of noise, inner product 0, otherwise cost the motion of two frames). Frames lost
-    // narrowly (on kitchen7s_dev with the fixed schedule, 0.03-0.05) re-seed: the next frame
-    // registered against the older reference was lost more often (15 frames instead of 13).
-    // A blank frame never replaces the reference.
-    const int min_points = params_.solver.min_points;
-    const bool unrelated = !too_few && s.status != SolverStatus::kNotFinite &&
-                           s.matched_fraction < 0.2 * op.lost_matched_fraction;
-    if (int(current->size()) >= min_points &&
-        (int(reference_->size()) < min_points || last_lost_ || !unrelated)) {
-      reference_ = std::move(current);
-    }
-    last_lost_ = true;
-    r.pose = pose_;
-    return r;
-  }
-
-  last_lost_ = false;
-  r.motion = s.transform;
-  velocity_ = s.transform;
-  velocity_interval_ = interval;
-  pose_ = normalized(pose_ * s.transform);
-  r.pose = pose_;
-  reference_ = std::move(current);
-
-  // Covariance from the curvature of the objective (negative definite at a maximum).
-  const Eigen::Matrix<double, 6, 6> info = -s.hessian;
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eig(0.5 * (info + info.transpose()));
-  Eigen::Matrix<double, 6, 1> lambda = eig.eigenvalues();
-  const double floor = 1e-12 * std::max(lambda.maxCoeff(), 1e-300);
-  bool degenerate = false;
-  for (int k = 0; k < 6; ++k) {
-    if (!(lambda[k] > floor)) {
-      lambda[k] = floor;
-      degenerate = true;
-    }
-  }
-  // Neighbouring pairs of one point are far from independent measurements: the curvature sums
-  // nnz pairs, but the information comes from the moving points. Scaling by pairs per point
-  // keeps one calibration valid whether colour lets few or many pairs through (measured:
-  // without it the flat-colour room's errors were 5x the textured room's relative to -H^-1).
-  // coarse_to_fine's information already weighs each point by its own kernel, whatever the
-  // number of its pairs (measured: with the factor the flat-colour room's errors were 2.8x
-  // smaller than the textured room's relative to the covariance, without it 1.x).
-  const double pairs_per_point =
-      params_.solver.ell_policy == EllPolicy::kCoarseToFine
-          ? 1.0
-          : double(std::max<std::size_t>(s.nnz, 1)) /
-                double(std::max<std::size_t>(r.moving_points, 1));
-  Eigen::Matrix<double, 6, 6> cov = eig.eigenvectors() * lambda.cwiseInverse().asDiagonal() *
-                                    eig.eigenvectors().transpose() *
-                                    (op.covariance_scale * pairs_per_point);
-  if (degenerate || !cov.allFinite()) {
-    cov = Eigen::Matrix<double, 6, 6>::Identity() * 1e6;
-    if (r.tracking == Tracking::kOk) {
-      r.tracking = Tracking::kHard;
-      r.message = "motion not constrained in every direction";
-    }
-  }
-  if (r.tracking == Tracking::kHard) cov *= 10.0;
-  r.motion_covariance = cov;
   return r;
+}
+
+void Odometry::tracked(OdometryResult& r, Registration reg,
+                       const std::shared_ptr<PreparedCloud>& current) {
+  const Tracked& keyframe = *keyframe_;
+  const Eigen::Isometry3d& to_keyframe = reg.solver.transform;
+  r.motion =
+      last_->index == keyframe.index ? to_keyframe : last_->to_keyframe.inverse() * to_keyframe;
+  r.motion_covariance = reg.covariance;
+  pose_ = normalized(keyframe.pose * to_keyframe);
+  pose_covariance_ = keyframe.covariance + rotateCovariance(reg.covariance, keyframe.pose.linear());
+  r.pose = pose_;
+  r.pose_covariance = pose_covariance_;
+  velocity_ = r.motion;
+  velocity_interval_ = r.interval;
+  lost_in_a_row_ = 0;
+
+  Tracked frame{current, r.frame_index, pose_, pose_covariance_, to_keyframe};
+  if (params_.odometry.reference == Reference::kPreviousFrame ||
+      takesKeyframe(reg.judgement, reg.solver, params_.odometry)) {
+    frame.to_keyframe = Eigen::Isometry3d::Identity();
+    keyframe_ = frame;
+    r.new_keyframe = true;
+  }
+  last_ = std::move(frame);
+}
+
+void Odometry::lost(OdometryResult& r, const Registration& reg,
+                    const std::shared_ptr<PreparedCloud>& current, double stamp) {
+  // Keep the last good pose; never extrapolate a motion we could not confirm.
+  velocity_ = Eigen::Isometry3d::Identity();
+  velocity_interval_ = 0.0;
+  r.motion = Eigen::Isometry3d::Identity();
+  r.motion_covariance = lostCovariance();
+  ++lost_in_a_row_;
+  r.pose = pose_;
+  r.pose_covariance =
+      last_->covariance + lostGrowth(stamp - last_->cloud->cloud.stamp, params_.odometry);
+  if (replacesReference(reg.solver, current->size(), keyframe_->cloud->size(), lost_in_a_row_,
+                        params_)) {
+    // The held pose with what it may be wrong by: the next frames are registered from here.
+    pose_covariance_ = r.pose_covariance;
+    keyframe_ = last_ =
+        Tracked{current, r.frame_index, pose_, pose_covariance_, Eigen::Isometry3d::Identity()};
+    r.new_keyframe = true;
+  }
 }
 
 }  // namespace acvo

@@ -42,6 +42,12 @@ struct EnumNames<SearchDirection> {
       {SearchDirection::kGradient, "gradient"}};
 };
 
+template <>
+struct EnumNames<Reference> {
+  static constexpr std::pair<Reference, const char*> table[] = {
+      {Reference::kKeyframe, "keyframe"}, {Reference::kPreviousFrame, "previous_frame"}};
+};
+
 template <typename Enum>
 std::string enumToString(Enum v) {
   for (const auto& [value, name] : EnumNames<Enum>::table) {
@@ -105,6 +111,9 @@ std::string toString(InitialGuess v) {
 std::string toString(SearchDirection v) {
   return enumToString(v);
 }
+std::string toString(Reference v) {
+  return enumToString(v);
+}
 void fromString(const std::string& s, EllPolicy& v) {
   enumFromString(s, v);
 }
@@ -115,6 +124,9 @@ void fromString(const std::string& s, InitialGuess& v) {
   enumFromString(s, v);
 }
 void fromString(const std::string& s, SearchDirection& v) {
+  enumFromString(s, v);
+}
+void fromString(const std::string& s, Reference& v) {
   enumFromString(s, v);
 }
 
@@ -174,6 +186,12 @@ std::string validate(const Params& p) {
   check(why, od.max_rotation > 0.0, "odometry.max_rotation", "must be positive");
   check(why, od.hard_ell_reductions > 0, "odometry.hard_ell_reductions", "must be positive");
   check(why, od.covariance_scale > 0.0, "odometry.covariance_scale", "must be positive");
+  check(why, od.keyframe_matched_fraction >= 0.0 && od.keyframe_matched_fraction <= 1.0,
+        "odometry.keyframe_matched_fraction", "must lie within [0, 1]");
+  check(why, od.keyframe_translation > 0.0, "odometry.keyframe_translation", "must be positive");
+  check(why, od.keyframe_rotation > 0.0, "odometry.keyframe_rotation", "must be positive");
+  check(why, od.lost_speed >= 0.0, "odometry.lost_speed", "must not be negative");
+  check(why, od.lost_angular_speed >= 0.0, "odometry.lost_angular_speed", "must not be negative");
   return why.str();
 }
 
@@ -188,6 +206,7 @@ Params paperParams() {
   p.solver.sparsification = 8.315e-3;
   p.solver.ell_depth_reference = 0.0;
   p.solver.depth_noise = 0.0;
+  p.odometry.reference = Reference::kPreviousFrame;  // the paper's frame-to-frame driver
   p.odometry.lost_matched_fraction = 0.02;
   p.odometry.hard_matched_fraction = 0.05;
   p.odometry.covariance_scale = 6e-4;

@@ -11,24 +11,27 @@ namespace acvo_ros {
 
 nav_msgs::Odometry toOdometryMsg(const acvo::OdometryResult& result,
                                  const Eigen::Isometry3d& base_from_camera,
-                                 const Covariance6& pose_covariance, double dt,
                                  const std_msgs::Header& header, const std::string& child) {
   const Eigen::Matrix3d rot = base_from_camera.rotation();
   nav_msgs::Odometry odom;
   odom.header = header;
   odom.child_frame_id = child;
   odom.pose.pose = toPoseMsg(conjugate(base_from_camera, result.pose));
-  const auto pose_cov = toArray(rotate(pose_covariance, rot));
+  const auto pose_cov = toArray(
+      acvo::rotateCovariance(toRosOrder(acvo::sanitiseCovariance(result.pose_covariance)), rot));
   std::copy(pose_cov.begin(), pose_cov.end(), odom.pose.covariance.begin());
 
   Covariance6 twist_cov = lostCovariance();
   const bool registered =
       result.tracking == acvo::Tracking::kOk || result.tracking == acvo::Tracking::kHard;
+  const double dt = result.interval;
   if (registered && dt > 0.0) {
     const Twist twist = twistOf(conjugate(base_from_camera, result.motion), dt);
     tf2::toMsg(twist.linear, odom.twist.twist.linear);
     tf2::toMsg(twist.angular, odom.twist.twist.angular);
-    twist_cov = rotate(toRosOrder(sanitise(result.motion_covariance)), rot) / (dt * dt);
+    twist_cov = acvo::rotateCovariance(
+                    toRosOrder(acvo::sanitiseCovariance(result.motion_covariance)), rot) /
+                (dt * dt);
   }
   const auto twist_arr = toArray(twist_cov);
   std::copy(twist_arr.begin(), twist_arr.end(), odom.twist.covariance.begin());
@@ -50,6 +53,11 @@ acvo::OdometryInfo toInfoMsg(const acvo::OdometryResult& result, const std_msgs:
   info.nnz = result.solver.nnz;
   info.inner_product = result.solver.inner_product;
   info.matched_fraction = result.solver.matched_fraction;
+  info.frame_index = result.frame_index;
+  info.keyframe_index = result.keyframe_index;
+  info.new_keyframe = result.new_keyframe;
+  info.fell_back_to_previous = result.fell_back_to_previous;
+  info.interval = result.interval;
   info.ms_cloud = result.ms_cloud;
   info.ms_registration = result.ms_registration;
   info.ms_total = ms_total;

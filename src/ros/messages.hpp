@@ -17,13 +17,13 @@
 namespace acvo_ros {
 
 // `header`: stamp and odometry frame; `child`: the base frame. The pose is the camera pose
-// conjugated by `base_from_camera`; `pose_covariance` (ROS order, first camera's axes) is
-// rotated into the base axes. The twist is the conjugated relative motion over `dt`, in the
-// base frame, with covariance motion_covariance / dt^2; it is zero with lostCovariance() for a
-// first frame, a lost frame or dt <= 0 (velocity unknown).
+// conjugated by `base_from_camera`; its covariance (result.pose_covariance, first camera's
+// axes) is put in ROS order and rotated into the base axes. The twist is the conjugated
+// relative motion over result.interval, in the base frame, with covariance
+// motion_covariance / interval^2; it is zero with lostCovariance() for a first frame, a lost
+// frame or an interval <= 0 (velocity unknown).
 nav_msgs::Odometry toOdometryMsg(const acvo::OdometryResult& result,
                                  const Eigen::Isometry3d& base_from_camera,
-                                 const Covariance6& pose_covariance, double dt,
                                  const std_msgs::Header& header, const std::string& child);
 
 acvo::OdometryInfo toInfoMsg(const acvo::OdometryResult& result, const std_msgs::Header& header,

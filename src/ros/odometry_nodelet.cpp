@@ -76,7 +76,7 @@ class OdometryNodelet : public nodelet::Nodelet {
   std::optional<acvo::Frame> toFrame(const Image& rgb, const Image& depth, const Info& info);
   std::string baseFrame() const;
   std::optional<Eigen::Isometry3d> baseFromCamera();
-  void publish(const acvo::OdometryResult& r, const std_msgs::Header& header, double dt);
+  void publish(const acvo::OdometryResult& r, const std_msgs::Header& header);
   void publishInfo(const acvo::OdometryResult& r, const std_msgs::Header& header, double ms_total);
   void rejectFrame(const std_msgs::Header& header, const std::string& why, double ms_total);
   void restart(const Eigen::Isometry3d& camera_pose);
@@ -103,7 +103,7 @@ class OdometryNodelet : public nodelet::Nodelet {
   message_filters::Subscriber<Info> info_sub_;
   std::unique_ptr<message_filters::Synchronizer<ExactPolicy>> exact_sync_;
   std::unique_ptr<message_filters::Synchronizer<ApproxPolicy>> approx_sync_;
-  ros::Publisher odom_pub_, cloud_pub_, info_pub_;
+  ros::Publisher odom_pub_, cloud_pub_, keyframe_cloud_pub_, info_pub_;
   ros::ServiceServer reset_srv_, reset_to_pose_srv_;
   std::unique_ptr<tf2_ros::Buffer> tf_buffer_;
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
@@ -118,13 +118,13 @@ class OdometryNodelet : public nodelet::Nodelet {
   std::mutex mutex_;
   acvo::Params params_;
   std::unique_ptr<acvo::Odometry> odometry_;
-  Covariance6 pose_covariance_ = originCovariance();   // ROS order, camera-0 axes
   std::string camera_frame_;                           // optical frame of the last image
   std::optional<Eigen::Isometry3d> base_from_camera_;  // looked up once per camera frame
   ros::Time last_stamp_;                               // stamp of the last frame processed
   std::uint32_t lost_count_ = 0;
-  std::uint64_t frames_ = 0;   // frames given to the odometry
-  bool synchronised_ = false;  // a frame came out of the synchroniser
+  std::uint64_t frames_ = 0;                         // frames given to the odometry
+  std::optional<std::uint64_t> published_keyframe_;  // last keyframe sent on keyframe_cloud
+  bool synchronised_ = false;                        // a frame came out of the synchroniser
   acvo::Tracking last_tracking_ = acvo::Tracking::kFirstFrame;
   std::string last_message_;
   double last_ms_total_ = 0.0;
@@ -141,6 +141,8 @@ void OdometryNodelet::onInit() {
 
   odom_pub_ = nh_.advertise<nav_msgs::Odometry>("odom", 10);
   cloud_pub_ = nh_.advertise<sensor_msgs::PointCloud2>("cloud", 2);
+  // Latched: the keyframe changes seldom, a late subscriber still gets the current one.
+  keyframe_cloud_pub_ = nh_.advertise<sensor_msgs::PointCloud2>("keyframe_cloud", 1, true);
   info_pub_ = nh_.advertise<acvo::OdometryInfo>("odom_info", 10);
   reset_srv_ = nh_.advertiseService("reset_odom", &OdometryNodelet::onReset, this);
   reset_to_pose_srv_ =
@@ -273,10 +275,6 @@ void OdometryNodelet::processFrame(const Image& rgb, const Image& depth, const I
     base_from_camera_.reset();
   }
 
-  // The motion of a registered frame spans the time since the engine's reference, which is
-  // not the last frame processed when lost frames came between (a blackout, a frame of noise).
-  const acvo::LabelledCloud* reference = odometry_->lastCloud();
-  const double reference_stamp = reference ? reference->stamp : 0.0;
   const acvo::OdometryResult r = odometry_->process(*frame);
   ++frames_;
   last_tracking_ = r.tracking;
@@ -288,23 +286,17 @@ void OdometryNodelet::processFrame(const Image& rgb, const Image& depth, const I
     publishInfo(r, header, msSince(start));
     return;
   }
-  const double dt = reference_stamp > 0.0 ? frame->stamp - reference_stamp : 0.0;
   last_stamp_ = header.stamp;
 
   if (r.tracking == acvo::Tracking::kLost) {
     ++lost_count_;
-    pose_covariance_ += lostCovariance();
-    NODELET_WARN_THROTTLE(2.0,
-                          "tracking lost (%s): holding the last pose, the reference restarts "
-                          "from this frame (%u lost so far)",
-                          r.message.c_str(), lost_count_);
-  } else if (r.tracking != acvo::Tracking::kFirstFrame) {
-    // The relative covariance is expressed in the previous camera's frame.
-    const Eigen::Matrix3d odom_from_previous = (r.pose * r.motion.inverse()).rotation();
-    pose_covariance_ =
-        accumulate(pose_covariance_, toRosOrder(r.motion_covariance), odom_from_previous);
+    NODELET_WARN_THROTTLE(2.0, "tracking lost (%s): holding the last pose, %s (%u lost so far)",
+                          r.message.c_str(),
+                          r.new_keyframe ? "the reference restarts from this frame"
+                                         : "the next frame is registered to the last good one",
+                          lost_count_);
   }
-  publish(r, header, dt);
+  publish(r, header);
   publishInfo(r, header, msSince(start));
 }
 
@@ -432,8 +424,7 @@ std::optional<Eigen::Isometry3d> OdometryNodelet::baseFromCamera() {
   return std::nullopt;
 }
 
-void OdometryNodelet::publish(const acvo::OdometryResult& r, const std_msgs::Header& header,
-                              double dt) {
+void OdometryNodelet::publish(const acvo::OdometryResult& r, const std_msgs::Header& header) {
   const std::optional<Eigen::Isometry3d> base_from_camera = baseFromCamera();
   if (!base_from_camera) return;
   const std::string base = baseFrame();
@@ -441,19 +432,26 @@ void OdometryNodelet::publish(const acvo::OdometryResult& r, const std_msgs::Hea
     std_msgs::Header odom_header;
     odom_header.stamp = header.stamp;
     odom_header.frame_id = odom_frame_;
-    const nav_msgs::Odometry odom =
-        toOdometryMsg(r, *base_from_camera, pose_covariance_, dt, odom_header, base);
+    const nav_msgs::Odometry odom = toOdometryMsg(r, *base_from_camera, odom_header, base);
     odom_pub_.publish(odom);
     if (publish_tf_) {
       tf_broadcaster_->sendTransform(
           toTransformMsg(conjugate(*base_from_camera, r.pose), odom_frame_, base, header.stamp));
     }
   }
-  const acvo::LabelledCloud* cloud = odometry_->lastCloud();
-  if (cloud && cloud_pub_.getNumSubscribers() > 0) {
-    std_msgs::Header cloud_header = header;
-    if (base_is_optical_) cloud_header.frame_id = base;  // the estimated camera, not the sensor's
-    cloud_pub_.publish(toPointCloud2(*cloud, cloud_header));
+  std_msgs::Header cloud_header = header;
+  if (base_is_optical_) cloud_header.frame_id = base;  // the estimated camera, not the sensor's
+  if (r.cloud && cloud_pub_.getNumSubscribers() > 0) {
+    cloud_pub_.publish(toPointCloud2(*r.cloud, cloud_header));
+  }
+  // The keyframe's cloud, in its own camera frame at its own stamp, once per keyframe.
+  const std::uint64_t keyframe = r.new_keyframe ? r.frame_index : r.keyframe_index;
+  const acvo::LabelledCloud* keyframe_cloud = odometry_->keyframeCloud();
+  if (keyframe_cloud && published_keyframe_ != keyframe &&
+      keyframe_cloud_pub_.getNumSubscribers() > 0) {
+    cloud_header.stamp.fromSec(keyframe_cloud->stamp);
+    keyframe_cloud_pub_.publish(toPointCloud2(*keyframe_cloud, cloud_header));
+    published_keyframe_ = keyframe;
   }
 }
 
@@ -465,7 +463,7 @@ void OdometryNodelet::publishInfo(const acvo::OdometryResult& r, const std_msgs:
 
 void OdometryNodelet::restart(const Eigen::Isometry3d& camera_pose) {
   odometry_->reset(camera_pose);
-  pose_covariance_ = originCovariance();
+  published_keyframe_.reset();
 }
 
 bool OdometryNodelet::onReset(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
@@ -531,9 +529,11 @@ void OdometryNodelet::onReconfigure(acvo::AcvoConfig& config, uint32_t /*level*/
     }
     if (describeParams(next) == describeParams(params_)) return;
     const Eigen::Isometry3d pose = odometry_->pose();
+    const acvo::Matrix6d covariance = odometry_->poseCovariance();
     params_ = next;
     odometry_ = std::make_unique<acvo::Odometry>(params_);
-    odometry_->reset(pose);
+    odometry_->reset(pose, covariance);
+    published_keyframe_.reset();
     NODELET_INFO("parameters changed, tracking restarts from the current pose: %s",
                  describeParams(params_).c_str());
   } catch (const std::exception& e) {

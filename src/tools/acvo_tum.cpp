@@ -121,7 +121,7 @@ int main(int argc, char** argv) {
       if (!stats) throw std::runtime_error("cannot write " + opt.stats);
       stats << "frame,stamp,tracking,status,points,fixed_points,iterations,ell,ell_at_bound,nnz,"
                "inner_product,matched_fraction,ms_selection,ms_labels,ms_prepare,ms_cloud,ms_neighbours,ms_step,ms_ell,"
-               "ms_registration,ms_frame,rss_kib\n";
+               "ms_registration,ms_frame,rss_kib,keyframe,new_keyframe\n";
     }
 
     acvo::Odometry odometry(params);
@@ -168,7 +168,8 @@ int main(int argc, char** argv) {
               << s.inner_product << ',' << s.matched_fraction << ',' << r.cloud_stats.ms_selection << ','
               << r.cloud_stats.ms_labels << ',' << r.ms_prepare << ',' << r.ms_cloud << ','
               << s.ms_neighbours << ',' << s.ms_step << ',' << s.ms_ell << ',' << r.ms_registration
-              << ',' << ms << ',' << acvo::tools::residentKiB() << '\n';
+              << ',' << ms << ',' << acvo::tools::residentKiB() << ',' << r.keyframe_index << ','
+              << int(r.new_keyframe) << '\n';
       }
       if (progress) {
         std::fprintf(stderr, "\racvo_tum: frame %ld/%ld  %3d it  %6.1f ms  %s    ", k - first + 1,

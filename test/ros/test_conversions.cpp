@@ -247,24 +247,6 @@ TEST(Covariance, ReordersRotationFirstToRosOrder) {
   EXPECT_EQ(ros(3, 0), 0.5);
 }
 
-TEST(Covariance, AccumulatesRotatedRelativeCovariances) {
-  Covariance6 rel = Covariance6::Zero();
-  rel.diagonal() << 1e-4, 0, 0, 0, 0, 0;  // along the camera's x only
-  const Eigen::Matrix3d quarter_turn =
-      Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).matrix();
-  Covariance6 pose_cov = originCovariance();
-  pose_cov = accumulate(pose_cov, rel, Eigen::Matrix3d::Identity());
-  pose_cov = accumulate(pose_cov, rel, quarter_turn);  // camera x is odom y now
-  EXPECT_NEAR(pose_cov(0, 0), 1e-4 + kOriginVariance, 1e-15);
-  EXPECT_NEAR(pose_cov(1, 1), 1e-4 + kOriginVariance, 1e-15);
-  EXPECT_NEAR(pose_cov(2, 2), kOriginVariance, 1e-15);
-  // A matrix the engine could not fill is treated as unknown motion.
-  Covariance6 bad = rel;
-  bad(1, 1) = std::nan("");
-  EXPECT_GE(accumulate(pose_cov, bad, Eigen::Matrix3d::Identity())(2, 2), kLostVariance);
-  EXPECT_TRUE(sanitise(rel).isApprox(rel));
-}
-
 TEST(StampCheck, DropsRepeatsRestartsOnJumpBackWarnsOnGaps) {
   EXPECT_EQ(checkStamp(0.0, 100.0, 1.0), StampVerdict::kAccept);
   EXPECT_EQ(checkStamp(100.0, 100.033, 1.0), StampVerdict::kAccept);
@@ -387,6 +369,7 @@ acvo::OdometryResult registered(const Eigen::Isometry3d& pose, const Eigen::Isom
   r.motion = motion;
   r.motion_covariance = Covariance6::Identity() * 1e-6;
   r.motion_covariance(0, 0) = 4e-6;  // rotation about the camera's x
+  r.interval = 0.1;
   return r;
 }
 
@@ -397,10 +380,10 @@ TEST(OdometryMsg, PoseTwistAndCovariancesAreInTheBaseFrame) {
   step.translation() << 0, 0, 0.02;  // 2 cm along the optical axis
   std_msgs::Header h;
   h.frame_id = "odom";
-  Covariance6 pose_cov = Covariance6::Zero();
-  pose_cov(0, 0) = 1e-4;  // along the first camera's x (the base's -y)
-  const nav_msgs::Odometry m =
-      toOdometryMsg(registered(step, step), base_from_optical, pose_cov, 0.1, h, "base_link");
+  acvo::OdometryResult r = registered(step, step);
+  r.pose_covariance = Covariance6::Zero();
+  r.pose_covariance(3, 3) = 1e-4;  // along the first camera's x (the base's -y); rotation first
+  const nav_msgs::Odometry m = toOdometryMsg(r, base_from_optical, h, "base_link");
   EXPECT_EQ(m.header.frame_id, "odom");
   EXPECT_EQ(m.child_frame_id, "base_link");
   EXPECT_NEAR(m.pose.pose.position.x, 0.02, 1e-12);  // forward is the base's x
@@ -418,15 +401,14 @@ TEST(OdometryMsg, VelocityIsUnknownOnFirstAndLostFrames) {
     acvo::OdometryResult r =
         registered(Eigen::Isometry3d::Identity(), Eigen::Isometry3d::Identity());
     r.tracking = t;
-    const nav_msgs::Odometry m =
-        toOdometryMsg(r, Eigen::Isometry3d::Identity(), originCovariance(), 0.1, {}, "cam");
+    const nav_msgs::Odometry m = toOdometryMsg(r, Eigen::Isometry3d::Identity(), {}, "cam");
     EXPECT_EQ(m.twist.twist.linear.x, 0.0);
     for (int d = 0; d < 6; ++d) EXPECT_EQ(m.twist.covariance[7 * d], kLostVariance);
   }
-  // dt = 0 (no previous stamp) too.
-  const nav_msgs::Odometry m =
-      toOdometryMsg(registered(Eigen::Isometry3d::Identity(), Eigen::Isometry3d::Identity()),
-                    Eigen::Isometry3d::Identity(), originCovariance(), 0.0, {}, "cam");
+  // An interval of 0 (no previous stamp) too.
+  acvo::OdometryResult r = registered(Eigen::Isometry3d::Identity(), Eigen::Isometry3d::Identity());
+  r.interval = 0.0;
+  const nav_msgs::Odometry m = toOdometryMsg(r, Eigen::Isometry3d::Identity(), {}, "cam");
   EXPECT_EQ(m.twist.covariance[0], kLostVariance);
 }
 
@@ -438,6 +420,11 @@ TEST(InfoMsg, CarriesTheResult) {
   r.solver.ell = 0.05;
   r.fixed_points = 1200;
   r.moving_points = 30;
+  r.frame_index = 41;
+  r.keyframe_index = 37;
+  r.new_keyframe = true;
+  r.fell_back_to_previous = true;
+  r.interval = 0.066;
   const acvo::OdometryInfo info = toInfoMsg(r, {}, 12.5, 3);
   EXPECT_TRUE(info.lost);
   EXPECT_EQ(info.tracking, acvo::toString(acvo::Tracking::kLost));
@@ -448,6 +435,11 @@ TEST(InfoMsg, CarriesTheResult) {
   EXPECT_EQ(info.ms_total, 12.5);
   EXPECT_EQ(info.lost_count, 3u);
   EXPECT_EQ(info.message, "too few points");
+  EXPECT_EQ(info.frame_index, 41u);
+  EXPECT_EQ(info.keyframe_index, 37u);
+  EXPECT_TRUE(info.new_keyframe);
+  EXPECT_TRUE(info.fell_back_to_previous);
+  EXPECT_EQ(info.interval, 0.066);
 }
 
 TEST(Diagnostics, NoDataFirstThenTheLastFramesJudgement) {

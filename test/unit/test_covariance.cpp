@@ -16,20 +16,27 @@ namespace {
 // chi-square with 6 degrees of freedom, 95% quantile.
 constexpr double kChi2Six95 = 12.5916;
 
+// NEES of each registration: the motion from the frame's camera to its keyframe's (the
+// previous frame's with the previous_frame reference) against the exact one, with the
+// reported motion_covariance (odometry.hpp).
 std::vector<double> neesOf(const synth::SequenceOptions& o, int* lost) {
   const synth::SynthSequence seq(o);
   Odometry odo;
   std::vector<double> nees;
+  std::vector<Eigen::Isometry3d> estimate;
   for (int i = 0; i < seq.size(); ++i) {
     const OdometryResult r = odo.process(seq.frame(i).toFrame());
+    estimate.push_back(r.pose);
     if (i == 0) continue;
     if (r.tracking == Tracking::kLost) {
       ++*lost;
       continue;
     }
-    const Eigen::Isometry3d truth = seq.poses()[i - 1].inverse() * seq.poses()[i];
-    // motion = exp(e) * estimate, e in the previous camera's frame (odometry.hpp).
-    const Vector6d e = logSE3(truth * r.motion.inverse());
+    const int k = int(r.keyframe_index);
+    const Eigen::Isometry3d truth = seq.poses()[k].inverse() * seq.poses()[i];
+    const Eigen::Isometry3d registered = estimate[k].inverse() * r.pose;
+    // registered = exp(e) * estimate, e in the keyframe camera's axes.
+    const Vector6d e = logSE3(truth * registered.inverse());
     nees.push_back(e.dot(r.motion_covariance.ldlt().solve(e)));
   }
   return nees;

@@ -46,8 +46,9 @@ TEST(Odometry, FirstFrameThenTracksAnExactSequence) {
   const OdometryResult first = odo.process(seq.frame(0).toFrame());
   EXPECT_EQ(first.tracking, Tracking::kFirstFrame);
   EXPECT_TRUE(first.pose.isApprox(seq.poses()[0]));
-  ASSERT_NE(odo.lastCloud(), nullptr);
-  EXPECT_GT(odo.lastCloud()->size(), 2000u);
+  ASSERT_NE(odo.keyframeCloud(), nullptr);
+  EXPECT_GT(odo.keyframeCloud()->size(), 2000u);
+  EXPECT_EQ(first.cloud.get(), odo.keyframeCloud());
   for (int i = 1; i < seq.size(); ++i) {
     const OdometryResult r = odo.process(seq.frame(i).toFrame());
     EXPECT_TRUE(r.tracking == Tracking::kOk || r.tracking == Tracking::kHard)
@@ -235,7 +236,7 @@ TEST(Odometry, ResetStartsAgainFromTheGivenPose) {
   Eigen::Isometry3d start = Eigen::Isometry3d::Identity();
   start.translation() << 1, 2, 3;
   odo.reset(start);
-  EXPECT_EQ(odo.lastCloud(), nullptr);
+  EXPECT_EQ(odo.keyframeCloud(), nullptr);
   const OdometryResult r = odo.process(seq.frame(2).toFrame());
   EXPECT_EQ(r.tracking, Tracking::kFirstFrame);
   EXPECT_TRUE(r.pose.isApprox(start));

@@ -55,7 +55,7 @@ TEST(Params, ConfigFileHoldsEveryKeyWithTheStructDefaults) {
   const Params loaded = loadParams(path);
   const auto got = flatten(loaded);
   const auto want = flatten(Params());
-  ASSERT_EQ(got.size(), 41u);  // every parameter of visitParams
+  ASSERT_EQ(got.size(), 47u);  // every parameter of visitParams
   EXPECT_EQ(got, want);
   // Equal values could also come from keys missing in the file: check each key is written.
   const YAML::Node file = YAML::LoadFile(path);
@@ -93,6 +93,9 @@ TEST(Params, EveryKeyIsReadIntoItsField) {
     } else if constexpr (std::is_same_v<T, InitialGuess>) {
       value = toString(field == InitialGuess::kIdentity ? InitialGuess::kConstantVelocity
                                                         : InitialGuess::kIdentity);
+    } else if constexpr (std::is_same_v<T, Reference>) {
+      value = toString(field == Reference::kKeyframe ? Reference::kPreviousFrame
+                                                     : Reference::kKeyframe);
     } else if constexpr (std::is_same_v<T, bool>) {
       value = field ? "false" : "true";
     } else if constexpr (std::is_same_v<T, int>) {
@@ -212,6 +215,13 @@ TEST(Params, EnumStringsRoundTrip) {
     fromString(toString(v), back);
     EXPECT_EQ(back, v);
   }
+  for (Reference v : {Reference::kKeyframe, Reference::kPreviousFrame}) {
+    Reference back = v == Reference::kKeyframe ? Reference::kPreviousFrame : Reference::kKeyframe;
+    fromString(toString(v), back);
+    EXPECT_EQ(back, v);
+  }
+  EXPECT_EQ(toString(Reference::kKeyframe), "keyframe");
+  EXPECT_EQ(toString(Reference::kPreviousFrame), "previous_frame");
   EXPECT_EQ(toString(SearchDirection::kConjugateGradient), "conjugate_gradient");
   EXPECT_EQ(toString(SearchDirection::kGradient), "gradient");
   EXPECT_EQ(toString(EllPolicy::kAdaptive), "adaptive");
@@ -252,6 +262,14 @@ TEST(Params, ValidateCatchesInconsistentValues) {
   EXPECT_NE(message([](Params& p) { p.solver.max_step = 0.1; }).find("min_step"),
             std::string::npos);
   EXPECT_NE(message([](Params& p) { p.odometry.threads = -1; }).find("threads"), std::string::npos);
+  EXPECT_NE(message([](Params& p) { p.odometry.keyframe_matched_fraction = 1.5; })
+                .find("odometry.keyframe_matched_fraction"),
+            std::string::npos);
+  EXPECT_NE(message([](Params& p) { p.odometry.keyframe_translation = 0.0; })
+                .find("odometry.keyframe_translation"),
+            std::string::npos);
+  EXPECT_NE(message([](Params& p) { p.odometry.lost_speed = -1.0; }).find("odometry.lost_speed"),
+            std::string::npos);
   // The YAML loader applies the same checks.
   const std::string msg = expectThrowMessage("solver:\n  sigma: -1\n");
   EXPECT_NE(msg.find("solver.sigma"), std::string::npos) << msg;
