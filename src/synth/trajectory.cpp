@@ -16,7 +16,10 @@ constexpr double kMaxRandomOffset = 0.5;  // m
 constexpr double kMaxRandomAngle = 0.5;   // rad (29 deg)
 constexpr double kXyzAmplitude = 0.2;     // m
 constexpr double kRpyAmplitude = 15.0 * M_PI / 180.0;
-constexpr double kCircleRadius = 0.5;  // m
+constexpr double kCircleRadius = 0.5;   // m
+constexpr double kSwaySideways = 0.03;  // m
+constexpr double kSwayVertical = 0.02;  // m
+constexpr double kSwayPan = 1.5 * M_PI / 180.0;
 
 // Back-and-forth profile on tau in [0, 1]: 0 -> +1 -> -1 -> 0 with zero velocity and
 // acceleration at both ends, so consecutive segments (one per axis) join smoothly.
@@ -49,6 +52,8 @@ std::optional<MotionKind> parseMotionKind(const std::string& name) {
   if (name == "xyz") return MotionKind::kXyz;
   if (name == "rpy") return MotionKind::kRpy;
   if (name == "circle") return MotionKind::kCircle;
+  if (name == "still") return MotionKind::kStill;
+  if (name == "sway") return MotionKind::kSway;
   return std::nullopt;
 }
 
@@ -62,6 +67,10 @@ std::string toString(MotionKind kind) {
       return "rpy";
     case MotionKind::kCircle:
       return "circle";
+    case MotionKind::kStill:
+      return "still";
+    case MotionKind::kSway:
+      return "sway";
   }
   return "?";
 }
@@ -147,6 +156,10 @@ Eigen::Isometry3d Motion::poseAt(double t) const {
       return rpyPose(t);
     case MotionKind::kCircle:
       return circlePose(t);
+    case MotionKind::kStill:
+      return options_.start;
+    case MotionKind::kSway:
+      return swayPose(t);
   }
   return options_.start;
 }
@@ -179,6 +192,18 @@ Eigen::Isometry3d Motion::rpyPose(double t) const {
   const int axis = axisOfSegment(segment);
   const double angle = kRpyAmplitude * backAndForth(t / period - segment);
   pose.linear() = pose.linear() * Eigen::AngleAxisd(angle, Eigen::Vector3d::Unit(axis));
+  return pose;
+}
+
+Eigen::Isometry3d Motion::swayPose(double t) const {
+  Eigen::Isometry3d pose = options_.start;
+  if (options_.speed <= 0.0) return pose;
+  const double gain = options_.speed / kReferenceSpeed;
+  const Eigen::Vector3d offset(gain * kSwaySideways * std::sin(2.0 * M_PI * 0.4 * t),
+                               gain * kSwayVertical * std::sin(2.0 * M_PI * 0.27 * t), 0.0);
+  pose.translation() += pose.linear() * offset;
+  const double pan = gain * kSwayPan * std::sin(2.0 * M_PI * 0.33 * t);
+  pose.linear() = pose.linear() * Eigen::AngleAxisd(pan, Eigen::Vector3d::UnitY()).matrix();
   return pose;
 }
 

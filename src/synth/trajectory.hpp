@@ -18,6 +18,10 @@
 //           speed * kAngularPerLinear, the optical centre fixed.
 //   circle  the optical centre moves on a horizontal circle of radius 0.5 m through the start
 //           position at `speed`, the camera always looking at kLookAtTarget (the room centre).
+//   still   the start pose at every instant (a camera standing still; `speed` is not used).
+//   sway    a camera held still by a hand or on a swaying robot: at the default speed (0.3)
+//           +-3 cm sideways at 0.4 Hz, +-2 cm up and down at 0.27 Hz and +-1.5 deg of pan at
+//           0.33 Hz about the start; the amplitudes scale with speed / 0.3.
 #pragma once
 
 #include <cstdint>
@@ -31,9 +35,9 @@
 
 namespace acvo::synth {
 
-enum class MotionKind { kRandom, kXyz, kRpy, kCircle };
+enum class MotionKind { kRandom, kXyz, kRpy, kCircle, kStill, kSway };
 
-// "random", "xyz", "rpy", "circle"; nullopt for anything else.
+// "random", "xyz", "rpy", "circle", "still", "sway"; nullopt for anything else.
 std::optional<MotionKind> parseMotionKind(const std::string& name);
 std::string toString(MotionKind kind);
 
@@ -66,6 +70,7 @@ class Motion {
   Eigen::Isometry3d xyzPose(double t) const;
   Eigen::Isometry3d rpyPose(double t) const;
   Eigen::Isometry3d circlePose(double t) const;
+  Eigen::Isometry3d swayPose(double t) const;
 
   MotionOptions options_;
   std::vector<Wave> translation_waves_[3], rotation_waves_[3];  // random motion only

@@ -23,7 +23,7 @@ writes it as a TUM RGB-D folder: rgb/<stamp>.png, depth/<stamp>.png (16-bit, 500
 options (default in brackets):
   --frames N             number of frames [300]
   --rate HZ              frame rate; stamps are 1000 + i / rate [30]
-  --motion KIND          random | xyz | rpy | circle [random]
+  --motion KIND          random | xyz | rpy | circle | still | sway [random]
   --speed M_PER_S        mean linear speed; angular speed follows (80 deg/s per m/s) [0.3]
   --seed N               scene, motion and noise seed [1]
   --structure on|off     furnished room, or a single plane filling the view [on]
@@ -92,7 +92,8 @@ Arguments parseArguments(int argc, char** argv) {
     } else if (option == "--motion") {
       const auto kind = acvo::synth::parseMotionKind(value);
       if (!kind)
-        throw UsageError("--motion expects random, xyz, rpy or circle, got '" + value + "'");
+        throw UsageError("--motion expects random, xyz, rpy, circle, still or sway, got '" + value +
+                         "'");
       o.motion = *kind;
     } else if (option == "--speed") {
       o.speed = parseNumber<double>(option, value);

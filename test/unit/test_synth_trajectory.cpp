@@ -10,8 +10,9 @@
 namespace acvo::synth {
 namespace {
 
+// Every kind that moves (`still` has its own test).
 const MotionKind kAllKinds[] = {MotionKind::kRandom, MotionKind::kXyz, MotionKind::kRpy,
-                                MotionKind::kCircle};
+                                MotionKind::kCircle, MotionKind::kSway};
 
 double angleBetween(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
   return Eigen::AngleAxisd(a.linear().transpose() * b.linear()).angle();
@@ -52,6 +53,29 @@ TEST(SynthTrajectory, StartsAtTheStartPose) {
   MotionOptions o = options(MotionKind::kCircle, 5);
   o.start = defaultStartPose() * Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ());
   EXPECT_LT((makeTrajectory(o)[0].matrix() - o.start.matrix()).norm(), 1e-12);
+}
+
+TEST(SynthTrajectory, StillStandsAtTheStartAndSwayStaysWithinCentimetres) {
+  for (const Eigen::Isometry3d& pose : makeTrajectory(options(MotionKind::kStill, 600))) {
+    EXPECT_EQ(pose.matrix(), defaultStartPose().matrix());
+  }
+  const Eigen::Isometry3d start = defaultStartPose();
+  double widest = 0.0, widest_angle = 0.0;
+  const auto sway = makeTrajectory(options(MotionKind::kSway, 600));
+  for (const Eigen::Isometry3d& pose : sway) {
+    const Eigen::Vector3d offset =
+        start.linear().transpose() * (pose.translation() - start.translation());
+    EXPECT_LE(std::abs(offset.x()), 0.03 + 1e-12);
+    EXPECT_LE(std::abs(offset.y()), 0.02 + 1e-12);
+    EXPECT_NEAR(offset.z(), 0.0, 1e-12);
+    widest = std::max(widest, offset.norm());
+    widest_angle = std::max(widest_angle, angleBetween(start, pose));
+  }
+  EXPECT_GT(widest, 0.03);  // both axes reach near their amplitude within 20 s
+  EXPECT_NEAR(widest_angle, 1.5 * M_PI / 180.0, 0.01 * M_PI / 180.0);
+  EXPECT_EQ(parseMotionKind("still"), MotionKind::kStill);
+  EXPECT_EQ(parseMotionKind("sway"), MotionKind::kSway);
+  EXPECT_EQ(toString(MotionKind::kSway), "sway");
 }
 
 TEST(SynthTrajectory, DefaultStartLooksIntoTheRoom) {
