@@ -24,7 +24,8 @@ double sparsificationThreshold(int order, double tolerance);
 double spatialRadius2(double ell, double sigma, double threshold);
 
 // Colour factor sigma_c^2 exp(-|f - g|^2 / 2 ell_c^2).
-inline float colorFactor(const Label& f, const Label& g, float color_ell2x2_inv, float color_sigma2) {
+inline float colorFactor(const Label& f, const Label& g, float color_ell2x2_inv,
+                         float color_sigma2) {
   return color_sigma2 * std::exp(-(f - g).squaredNorm() * color_ell2x2_inv);
 }
 
@@ -59,11 +60,17 @@ struct SelfPair {
 
 // A cloud ready for registration: its points, labels, search grid and self-kernel pairs,
 // computed once per frame (the self-kernel of frame k is the fixed self-kernel of frame k+1).
+// A cloud registered *to* (a reference: the fixed cloud of align) also needs the search grids
+// of the other length-scales the solver uses (prepareReference).
 struct PreparedCloud {
   LabelledCloud cloud;
-  VoxelGrid grid;                 // cell = the search radius at the largest length-scale
-  VoxelGrid coarse_grid;          // cell = the search radius at the coarse stage's length-scale
-  std::vector<VoxelGrid> level_grids;  // coarse_to_fine: one grid per level (levelElls)
+  // cell = the search radius at the largest length-scale (adaptive, fixed_schedule) or at
+  // ell_min (coarse_to_fine: the finest level's grid)
+  VoxelGrid grid;
+  bool reference = false;  // the grids below are built
+  VoxelGrid coarse_grid;   // cell = the search radius at the coarse stage's length-scale
+  // coarse_to_fine: one grid per level of levelElls but the last (which searches `grid`)
+  std::vector<VoxelGrid> level_grids;
   std::vector<SelfPair> self_pairs;  // all pairs within that radius that can pass the threshold
   // The same pairs' d2 and colour factors as arrays, for vectorised sums per iteration.
   Eigen::ArrayXf self_d2, self_color;
@@ -87,7 +94,9 @@ inline float ellScale(float z, const SolverParams& p) {
   return s < kMinEllScale ? kMinEllScale : (s > kMaxEllScale ? kMaxEllScale : s);
 }
 // The largest factor by which a point's search radius may exceed the unit radius.
-inline float maxEllScale(const SolverParams& p) { return perPointKernel(p) ? kMaxEllScale : 1.0f; }
+inline float maxEllScale(const SolverParams& p) {
+  return perPointKernel(p) ? kMaxEllScale : 1.0f;
+}
 
 // The largest spatial length-scale the solver's main stage may use with these parameters.
 double largestEll(const SolverParams& params);
@@ -97,7 +106,13 @@ std::vector<double> levelElls(const SolverParams& params);
 // Cell of a search grid serving radii up to that of length-scale `ell`.
 float gridCell(double ell, const SolverParams& params);
 
-PreparedCloud prepareCloud(LabelledCloud cloud, const SolverParams& params);
+// The self-kernel pairs and the grid that found them, and with `as_reference` the search grids
+// a fixed cloud needs as well (prepareReference).
+PreparedCloud prepareCloud(LabelledCloud cloud, const SolverParams& params,
+                           bool as_reference = true);
+// Builds what a cloud registered *to* needs beyond prepareCloud(..., false), once (a keyframe
+// when it becomes one); returns the milliseconds it took (0 when already done).
+double prepareReference(PreparedCloud& cloud, const SolverParams& params);
 
 // ---------------------------------------------------------------------------------------------
 template <typename F>

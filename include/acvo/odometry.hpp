@@ -51,8 +51,9 @@ struct OdometryResult {
   SolverResult solver;                         // the registration that decided this frame
   std::size_t fixed_points = 0;                // points of the cloud registered to
   std::size_t moving_points = 0;
-  double ms_cloud = 0.0;         // building this frame's cloud (selection + labels + self-kernel)
-  double ms_prepare = 0.0;       // of which: search grid + self-kernel pairs
+  double ms_cloud = 0.0;  // building this frame's cloud (selection + labels + self-kernel)
+  // of which: search grids + self-kernel pairs (a keyframe's grids when it became one)
+  double ms_prepare = 0.0;
   double ms_registration = 0.0;  // the solver (both registrations when it fell back)
   CloudStats cloud_stats;
 };
@@ -128,13 +129,15 @@ class Odometry {
  private:
   // A frame with a known pose, kept as the keyframe or as the last tracked frame.
   struct Tracked {
-    std::shared_ptr<const PreparedCloud> cloud;
+    std::shared_ptr<PreparedCloud> cloud;
     std::uint64_t index = 0;
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();         // camera in the odometry frame
     Matrix6d covariance = Matrix6d::Zero();                         // of pose
     Eigen::Isometry3d to_keyframe = Eigen::Isometry3d::Identity();  // camera -> keyframe camera
   };
   struct Registration;
+  // Builds the search grids a cloud registered to needs (prepareReference), timed into r.
+  void asReference(OdometryResult& r, PreparedCloud& cloud);
   Registration registerTo(const Tracked& reference, const PreparedCloud& current,
                           const Eigen::Isometry3d& guess);
   void tracked(OdometryResult& r, Registration reg, const std::shared_ptr<PreparedCloud>& current);

@@ -15,9 +15,9 @@ enum class SearchDirection { kConjugateGradient, kGradient };
 enum class Reference { kKeyframe, kPreviousFrame };
 
 struct SelectionParams {
-  int target_points = 4000;  // semi-dense cloud size the selector aims at (paper: 3000)
-  double min_depth = 0.1;    // m; points outside [min_depth, max_depth] are dropped
-  double max_depth = 4.0;    // m (paper: 6; Kinect depth beyond 4 m is too coarse to help)
+  int target_points = 4000;    // semi-dense cloud size the selector aims at (paper: 3000)
+  double min_depth = 0.1;      // m; points outside [min_depth, max_depth] are dropped
+  double max_depth = 4.0;      // m (paper: 6; Kinect depth beyond 4 m is too coarse to help)
   bool canny_fallback = true;  // add Canny edge pixels when fewer than target/3 were selected
 };
 
@@ -25,21 +25,21 @@ struct SolverParams {
   // coarse_to_fine (not in the paper, the default: see alignLevels in solver.cpp), adaptive
   // (A-CVO) or fixed_schedule (CVO).
   EllPolicy ell_policy = EllPolicy::kCoarseToFine;
-  EllUpdate ell_update = EllUpdate::kDescent;   // descent (paper) or reference (authors' code)
+  EllUpdate ell_update = EllUpdate::kDescent;  // descent (paper) or reference (authors' code)
   // Direction of each iteration: the gradient (paper) or nonlinear conjugate gradient
   // (Polak-Ribiere+, not in the paper; measured: 2.5-3x fewer iterations, see config/acvo.yaml).
   SearchDirection direction = SearchDirection::kConjugateGradient;
   // m, initial spatial length-scale (reset per frame); coarse_to_fine: its first level
   double ell_init = 0.04;
-  double ell_min = 0.0045;      // m; coarse_to_fine: its last level (paper: 0.0391)
-  double ell_max = 0.15;        // m (only shrinks within a frame, reset per frame)
-  double ell_step = 0.3;        // gamma_l, step of the length-scale update
+  double ell_min = 0.0045;  // m; coarse_to_fine: its last level (paper: 0.0391)
+  double ell_max = 0.15;    // m (only shrinks within a frame, reset per frame)
+  double ell_step = 0.3;    // gamma_l, step of the length-scale update
   // lambda_l, factor applied to ell_max when ell reaches it (paper: 0.7); coarse_to_fine: the
   // ratio of one level's length-scale to the previous one's
   double ell_reduction = 0.25;
-  double sigma = 0.1;           // spatial signal std
-  double color_ell = 0.1;       // colour length-scale (paper 0.1; measured, see config/acvo.yaml)
-  double color_sigma = 1.0;     // colour signal std
+  double sigma = 0.1;        // spatial signal std
+  double color_ell = 0.1;    // colour length-scale (paper 0.1; measured, see config/acvo.yaml)
+  double color_sigma = 1.0;  // colour signal std
   // a_ij below this are dropped. Paper: 8.315e-3 = 0.83 sigma^2, which keeps only pairs within
   // 0.61 ell (a flat-topped kernel); 1.1e-4 = sigma^2 exp(-4.5) keeps the Gaussian to 3 ell.
   double sparsification = 1.1e-4;
@@ -57,10 +57,10 @@ struct SolverParams {
   // Coarse stage (not in the paper): before the main iterations, a few CVO iterations with a
   // wide fixed length-scale on a subset of the moving points widen the basin of convergence
   // (a 5 degree rotation moves points 17 cm at 2 m, beyond the reach of ell_max). 0 = off.
-  double coarse_ell = 0.4;      // m
-  int coarse_points = 500;      // moving points used by the coarse stage (evenly strided)
-  int coarse_iterations = 20;   // iteration cap of the coarse stage
-  int min_points = 30;          // fewer points in either cloud -> status too_few_points
+  double coarse_ell = 0.4;     // m
+  int coarse_points = 500;     // moving points used by the coarse stage (evenly strided)
+  int coarse_iterations = 20;  // iteration cap of the coarse stage
+  int min_points = 30;         // fewer points in either cloud -> status too_few_points
   // coarse_to_fine only (see config/acvo.yaml for the measurements):
   // Range-dependent length-scale: a point at depth z uses ell * z / ell_depth_reference (the
   // factor clamped to [0.5, 3]), so that the kernel spans the same pixels near and far. 0 = off.
@@ -71,7 +71,12 @@ struct SolverParams {
   double depth_noise = 0.0025;  // 1/m
   int level_points = 200;       // moving points at the first level (x ell_init / ell after)
   int level_iterations = 10;    // Gauss-Newton iterations per level, at most
-  double level_eps = 2e-4;      // next level when an iteration moves less (rad and m)
+  // Next level when an iteration moves less than level_eps * ell / ell_min (rad and m): the
+  // finest level to level_eps, a coarser one in proportion to its length-scale.
+  double level_eps = 2e-4;
+  // Steps that keep their direction and shrink by a ratio rho are extended by 1 / (1 - rho),
+  // rho capped at this (extrapolatedStep; 0 = plain Gauss-Newton steps).
+  double level_acceleration = 0.5;
 };
 
 struct OdometryParams {
@@ -79,31 +84,31 @@ struct OdometryParams {
   // What each frame is registered to (not in the paper, which registers to the previous frame):
   // a keyframe, kept while the frames still overlap it (a camera that stands still or sways
   // then collects no drift), or the previous frame. See odometry.hpp.
-  Reference reference = Reference::kPreviousFrame;
+  Reference reference = Reference::kKeyframe;
   // keyframe only: a frame registered to the keyframe becomes the next keyframe when fewer
   // than this fraction of its points found a kernel partner in the keyframe, when its motion
   // from the keyframe exceeds keyframe_translation or keyframe_rotation, or when it was hard
   // to track.
   double keyframe_matched_fraction = 0.5;
-  double keyframe_translation = 0.1;  // m
-  double keyframe_rotation = 5.0;     // deg
-  int threads = 0;  // 0 = all cores
+  double keyframe_translation = 0.05;  // m
+  double keyframe_rotation = 2.0;      // deg
+  int threads = 0;                     // 0 = all cores
   // Tracking judgement (see odometry.hpp): lost when fewer than this fraction of the frame's
   // points found a kernel partner at the solution (nothing in common), or when a frame-to-frame
   // motion exceeds the limits below; hard to track below hard_matched_fraction.
   double lost_matched_fraction = 0.1;
   double hard_matched_fraction = 0.25;
-  double max_translation = 0.3;   // m per frame
-  double max_rotation = 20.0;     // deg per frame
-  int hard_ell_reductions = 3;    // hard to track when ell_max was reduced this often in a frame
+  double max_translation = 0.3;  // m per frame
+  double max_rotation = 20.0;    // deg per frame
+  int hard_ell_reductions = 3;   // hard to track when ell_max was reduced this often in a frame
   // Relative-motion covariance = covariance_scale * (pairs per point) * (-H)^-1, H the curvature
   // of the objective at the optimum; see odometry.hpp (calibration in config/acvo.yaml).
-  double covariance_scale = 3.5e-7;
+  double covariance_scale = 3.0e-7;
   // While tracking is lost the camera may move unseen: the held pose's covariance grows by
   // (lost_speed * t)^2 and (lost_angular_speed * t)^2, t the time since the last tracked frame
   // (a hand-held camera: 0.35 m/s and up to 100 deg/s on TUM fr3/teddy).
-  double lost_speed = 1.0;            // m/s
-  double lost_angular_speed = 90.0;   // deg/s
+  double lost_speed = 1.0;           // m/s
+  double lost_angular_speed = 90.0;  // deg/s
 };
 
 struct Params {
@@ -161,6 +166,7 @@ void visitParams(Params_& p, Visitor&& visit) {
   visit("solver", "level_points", p.solver.level_points);
   visit("solver", "level_iterations", p.solver.level_iterations);
   visit("solver", "level_eps", p.solver.level_eps);
+  visit("solver", "level_acceleration", p.solver.level_acceleration);
   visit("odometry", "initial_guess", p.odometry.initial_guess);
   visit("odometry", "threads", p.odometry.threads);
   visit("odometry", "reference", p.odometry.reference);

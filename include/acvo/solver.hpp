@@ -20,10 +20,10 @@ std::string toString(SolverStatus s);
 
 // What one iteration did (kept for tests, benchmarks and diagnosis; a few doubles each).
 struct IterationTrace {
-  double ell = 0.0;      // length-scale used by the iteration
-  double ell_max = 0.0;  // ell_max after the iteration's update
-  double step = 0.0;     // step size t
-  double change = 0.0;   // t |xi|: the SE(3) change of the iteration
+  double ell = 0.0;        // length-scale used by the iteration
+  double ell_max = 0.0;    // ell_max after the iteration's update
+  double step = 0.0;       // step size t
+  double change = 0.0;     // t |xi|: the SE(3) change of the iteration
   double objective = 0.0;  // F before the update
   std::int64_t nnz = 0;
 };
@@ -32,19 +32,19 @@ struct SolverResult {
   // Maps points of the moving (current) cloud into the fixed (previous) cloud's frame.
   Eigen::Isometry3d transform = Eigen::Isometry3d::Identity();
   SolverStatus status = SolverStatus::kTooFewPoints;
-  int iterations = 0;          // main-stage iterations
-  int coarse_iterations = 0;   // coarse-stage iterations (SolverParams::coarse_ell)
+  int iterations = 0;         // main-stage iterations
+  int coarse_iterations = 0;  // coarse-stage iterations (SolverParams::coarse_ell)
   // Stopped by the stall rule (SolverParams::stall_iterations): the transform is the best
   // iterate at the final length-scale, not the last one.
   bool stalled = false;
-  int list_builds = 0;         // candidate-list rebuilds of the main stage
-  double ell = 0.0;            // final spatial length-scale
-  bool ell_at_bound = false;   // final ell pinned at ell_min or at the (shrunk) ell_max
+  int list_builds = 0;           // candidate-list rebuilds of the main stage
+  double ell = 0.0;              // final spatial length-scale
+  bool ell_at_bound = false;     // final ell pinned at ell_min or at the (shrunk) ell_max
   int ell_bound_iterations = 0;  // iterations that ended with ell pinned at a bound
   // Times ell reached ell_max and the bound was reduced: the length-scale gradient kept asking
   // for a wider kernel, the sign of weak structure (the paper's "hard to track" signal).
   int ell_max_reductions = 0;
-  std::size_t nnz = 0;         // kept cross-kernel entries at the last iteration
+  std::size_t nnz = 0;  // kept cross-kernel entries at the last iteration
   // Fraction of the moving points with at least one kept pair at the returned transform: how
   // much of this frame found something to hold on to in the reference.
   double matched_fraction = 0.0;
@@ -52,7 +52,7 @@ struct SolverResult {
   // Curvature of the objective F at the optimum w.r.t. a left perturbation
   // (omega, v) of the transform, 6x6, negative semi-definite at a maximum.
   Eigen::Matrix<double, 6, 6> hessian = Eigen::Matrix<double, 6, 6>::Zero();
-  double objective = 0.0;      // F at the optimum
+  double objective = 0.0;  // F at the optimum
   std::vector<IterationTrace> trace;
   // Time per stage, milliseconds.
   double ms_total = 0.0;
@@ -74,6 +74,13 @@ double solveStep(double B, double C, double D, double E, double min_step, double
 // previous gradient and the previous direction; always an ascent direction (d.g > 0), g itself
 // when the previous iteration gives nothing to build on.
 Vector6d conjugateDirection(const Vector6d& g, const Vector6d& g_prev, const Vector6d& d_prev);
+
+// A coarse_to_fine Gauss-Newton step (a left increment, se(3)) extended along its direction:
+// the steps of the minorise-maximise iteration shrink geometrically (ratio 0.4-0.7 per
+// iteration on real frames), so when `step` points the way `previous` did (cosine above 0.9)
+// and is shorter by a ratio rho < 1, the rest of that geometric series is taken at once:
+// step / (1 - min(rho, max_ratio)). `step` itself otherwise, and when max_ratio is 0.
+Vector6d extrapolatedStep(const Vector6d& step, const Vector6d& previous, double max_ratio);
 
 // The length-scale for a fixed-schedule iteration (CVO: 0.15, 0.10 after 2, 0.06 after 9,
 // 0.03 after 19).

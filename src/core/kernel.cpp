@@ -112,7 +112,26 @@ float gridCell(double ell, const SolverParams& p) {
          maxEllScale(p);
 }
 
-PreparedCloud prepareCloud(LabelledCloud cloud, const SolverParams& p) {
+double prepareReference(PreparedCloud& cloud, const SolverParams& p) {
+  if (cloud.reference) return 0.0;
+  const auto t0 = std::chrono::steady_clock::now();
+  if (p.ell_policy == EllPolicy::kCoarseToFine) {
+    // The finest level searches `grid` (built for the self pairs at ell_min).
+    const std::vector<double> ells = levelElls(p);
+    for (std::size_t level = 0; level + 1 < ells.size(); ++level) {
+      cloud.level_grids.emplace_back(cloud.cloud.points, gridCell(ells[level], p));
+    }
+  } else if (p.coarse_ell > 0.0) {
+    cloud.coarse_grid = VoxelGrid(cloud.cloud.points, gridCell(p.coarse_ell, p));
+  }
+  cloud.reference = true;
+  const double ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  cloud.ms_prepare += ms;
+  return ms;
+}
+
+PreparedCloud prepareCloud(LabelledCloud cloud, const SolverParams& p, bool as_reference) {
   const auto t0 = std::chrono::steady_clock::now();
   PreparedCloud out;
   out.cloud = std::move(cloud);
@@ -122,11 +141,6 @@ PreparedCloud prepareCloud(LabelledCloud cloud, const SolverParams& p) {
   const double self_ell = levels ? p.ell_min : largestEll(p);
   const double r2 = spatialRadius2(self_ell, p.sigma, p.sparsification);
   out.grid = VoxelGrid(out.cloud.points, gridCell(self_ell, p));
-  if (levels) {
-    for (double ell : levelElls(p)) out.level_grids.emplace_back(out.cloud.points, gridCell(ell, p));
-  } else if (p.coarse_ell > 0.0) {
-    out.coarse_grid = VoxelGrid(out.cloud.points, gridCell(p.coarse_ell, p));
-  }
 
   const float sigma2 = float(p.sigma * p.sigma);
   const float color_sigma2 = float(p.color_sigma * p.color_sigma);
@@ -153,6 +167,7 @@ PreparedCloud prepareCloud(LabelledCloud cloud, const SolverParams& p) {
   }
   out.ms_prepare =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  if (as_reference) prepareReference(out, p);
   return out;
 }
 

@@ -155,6 +155,13 @@ const LabelledCloud* Odometry::keyframeCloud() const {
   return keyframe_ ? &keyframe_->cloud->cloud : nullptr;
 }
 
+void Odometry::asReference(OdometryResult& r, PreparedCloud& cloud) {
+  double ms = 0.0;
+  arena_->arena.execute([&] { ms = prepareReference(cloud, params_.solver); });
+  r.ms_prepare += ms;
+  r.ms_cloud += ms;
+}
+
 Odometry::Registration Odometry::registerTo(const Tracked& reference, const PreparedCloud& current,
                                             const Eigen::Isometry3d& guess) {
   Registration reg;
@@ -204,9 +211,13 @@ OdometryResult Odometry::process(const Frame& frame,
 
   const auto t0 = Clock::now();
   std::shared_ptr<PreparedCloud> current;
+  // Frame to frame, every frame becomes the reference: its search grids are built with it.
+  // With keyframes, only when it becomes one (asReference).
+  const bool every_frame_a_reference = params_.odometry.reference == Reference::kPreviousFrame;
   arena_->arena.execute([&] {
     current = std::make_shared<PreparedCloud>(
-        prepareCloud(buildLabelledCloud(frame, params_.selection, &r.cloud_stats), params_.solver));
+        prepareCloud(buildLabelledCloud(frame, params_.selection, &r.cloud_stats), params_.solver,
+                     every_frame_a_reference));
   });
   r.ms_cloud = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
   r.moving_points = current->size();
@@ -216,6 +227,7 @@ OdometryResult Odometry::process(const Frame& frame,
 
   if (!keyframe_) {
     lost_in_a_row_ = 0;
+    asReference(r, *current);
     keyframe_ = last_ =
         Tracked{current, r.frame_index, pose_, pose_covariance_, Eigen::Isometry3d::Identity()};
     r.tracking = Tracking::kFirstFrame;
@@ -239,6 +251,7 @@ OdometryResult Odometry::process(const Frame& frame,
   // Failed against the keyframe: the last tracked frame, closer in time, may still overlap.
   if (reg.judgement.tracking == Tracking::kLost && !last_is_keyframe &&
       int(current->size()) >= params_.solver.min_points) {
+    asReference(r, *last_->cloud);
     Registration to_last = registerTo(*last_, *current, prior);
     r.ms_registration += to_last.solver.ms_total;
     if (to_last.judgement.tracking != Tracking::kLost) {
@@ -285,6 +298,7 @@ void Odometry::tracked(OdometryResult& r, Registration reg,
   if (params_.odometry.reference == Reference::kPreviousFrame ||
       takesKeyframe(reg.judgement, reg.solver, params_.odometry)) {
     frame.to_keyframe = Eigen::Isometry3d::Identity();
+    asReference(r, *current);
     keyframe_ = frame;
     r.new_keyframe = true;
   }
@@ -306,6 +320,7 @@ void Odometry::lost(OdometryResult& r, const Registration& reg,
                         params_)) {
     // The held pose with what it may be wrong by: the next frames are registered from here.
     pose_covariance_ = r.pose_covariance;
+    asReference(r, *current);
     keyframe_ = last_ =
         Tracked{current, r.frame_index, pose_, pose_covariance_, Eigen::Isometry3d::Identity()};
     r.new_keyframe = true;

@@ -177,11 +177,15 @@ std::string validate(const Params& p) {
   check(why, so.level_points > 0, "solver.level_points", "must be positive");
   check(why, so.level_iterations > 0, "solver.level_iterations", "must be positive");
   check(why, so.level_eps > 0.0, "solver.level_eps", "must be positive");
+  check(why, so.level_acceleration >= 0.0 && so.level_acceleration < 1.0,
+        "solver.level_acceleration", "must lie in [0, 1)");
   const OdometryParams& od = p.odometry;
   check(why, od.threads >= 0, "odometry.threads", "must not be negative (0 = all cores)");
-  check(why, od.lost_matched_fraction >= 0.0 && od.lost_matched_fraction <= od.hard_matched_fraction,
+  check(why,
+        od.lost_matched_fraction >= 0.0 && od.lost_matched_fraction <= od.hard_matched_fraction,
         "odometry.lost_matched_fraction", "must lie within [0, hard_matched_fraction]");
-  check(why, od.hard_matched_fraction <= 1.0, "odometry.hard_matched_fraction", "must not exceed 1");
+  check(why, od.hard_matched_fraction <= 1.0, "odometry.hard_matched_fraction",
+        "must not exceed 1");
   check(why, od.max_translation > 0.0, "odometry.max_translation", "must be positive");
   check(why, od.max_rotation > 0.0, "odometry.max_rotation", "must be positive");
   check(why, od.hard_ell_reductions > 0, "odometry.hard_ell_reductions", "must be positive");

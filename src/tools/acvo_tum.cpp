@@ -110,17 +110,18 @@ int main(int argc, char** argv) {
     const std::string output =
         opt.output.empty() ? opt.dataset + "/acvo_trajectory.txt" : opt.output;
     const long first = std::min<long>(opt.start, long(data.size()));
-    const long last = opt.frames < 0 ? long(data.size())
-                                     : std::min<long>(long(data.size()), first + opt.frames);
-    if (first >= last) usageError("no frames to process (dataset has " +
-                                  std::to_string(data.size()) + ")");
+    const long last =
+        opt.frames < 0 ? long(data.size()) : std::min<long>(long(data.size()), first + opt.frames);
+    if (first >= last)
+      usageError("no frames to process (dataset has " + std::to_string(data.size()) + ")");
 
     std::ofstream stats;
     if (!opt.stats.empty()) {
       stats.open(opt.stats);
       if (!stats) throw std::runtime_error("cannot write " + opt.stats);
       stats << "frame,stamp,tracking,status,points,fixed_points,iterations,ell,ell_at_bound,nnz,"
-               "inner_product,matched_fraction,ms_selection,ms_labels,ms_prepare,ms_cloud,ms_neighbours,ms_step,ms_ell,"
+               "inner_product,matched_fraction,ms_selection,ms_labels,ms_prepare,ms_cloud,ms_"
+               "neighbours,ms_step,ms_ell,"
                "ms_registration,ms_frame,rss_kib,keyframe,new_keyframe\n";
     }
 
@@ -148,12 +149,13 @@ int main(int argc, char** argv) {
         ++failures;
         continue;
       }
-      const bool failed = r.tracking == acvo::Tracking::kLost ||
-                          r.tracking == acvo::Tracking::kBadFrame;
+      const bool failed =
+          r.tracking == acvo::Tracking::kLost || r.tracking == acvo::Tracking::kBadFrame;
       if (failed) {
         ++failures;
-        std::cerr << (progress ? "\n" : "") << "acvo_tum: frame " << k << " (" << entry.rgb.stamp_text
-                  << "): " << acvo::toString(r.tracking) << ": " << r.message << "\n";
+        std::cerr << (progress ? "\n" : "") << "acvo_tum: frame " << k << " ("
+                  << entry.rgb.stamp_text << "): " << acvo::toString(r.tracking) << ": "
+                  << r.message << "\n";
       }
       if (r.tracking != acvo::Tracking::kBadFrame) {
         trajectory.push_back({entry.rgb.stamp_text, entry.rgb.stamp, r.pose});
@@ -165,8 +167,8 @@ int main(int argc, char** argv) {
         stats << k << ',' << entry.rgb.stamp_text << ',' << acvo::toString(r.tracking) << ','
               << acvo::toString(s.status) << ',' << r.moving_points << ',' << r.fixed_points << ','
               << s.iterations << ',' << s.ell << ',' << int(s.ell_at_bound) << ',' << s.nnz << ','
-              << s.inner_product << ',' << s.matched_fraction << ',' << r.cloud_stats.ms_selection << ','
-              << r.cloud_stats.ms_labels << ',' << r.ms_prepare << ',' << r.ms_cloud << ','
+              << s.inner_product << ',' << s.matched_fraction << ',' << r.cloud_stats.ms_selection
+              << ',' << r.cloud_stats.ms_labels << ',' << r.ms_prepare << ',' << r.ms_cloud << ','
               << s.ms_neighbours << ',' << s.ms_step << ',' << s.ms_ell << ',' << r.ms_registration
               << ',' << ms << ',' << acvo::tools::residentKiB() << ',' << r.keyframe_index << ','
               << int(r.new_keyframe) << '\n';

@@ -55,10 +55,11 @@ TEST_P(Covariance, NormalisedErrorsAreConsistentWithTheReportedCovariance) {
       double(std::count_if(nees.begin(), nees.end(), [](double x) { return x < kChi2Six95; })) /
       double(nees.size());
   std::sort(nees.begin(), nees.end());
-  std::printf("  %zu frames, %d lost: %.1f%% inside the 95%% ellipsoid, median NEES %.4g, "
-              "95th percentile %.4g (chi2_6: 5.35, 12.59)\n",
-              nees.size(), lost, 100 * inside, nees[nees.size() / 2],
-              nees[size_t(0.95 * double(nees.size()))]);
+  std::printf(
+      "  %zu frames, %d lost: %.1f%% inside the 95%% ellipsoid, median NEES %.4g, "
+      "95th percentile %.4g (chi2_6: 5.35, 12.59)\n",
+      nees.size(), lost, 100 * inside, nees[nees.size() / 2],
+      nees[size_t(0.95 * double(nees.size()))]);
   EXPECT_GE(inside, 0.80);
   EXPECT_LE(inside, 0.99);
 }

@@ -1,9 +1,10 @@
 // The frame-to-frame pipeline: state, tracking judgement, covariance, bad frames.
+#include <cmath>
 #include <cstdio>
 #include <limits>
 
-#include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
+#include <Eigen/Eigenvalues>
 
 #include "acvo/odometry.hpp"
 #include "acvo/se3.hpp"
@@ -258,6 +259,235 @@ TEST(Odometry, DeterministicForTheSameFramesWhateverTheThreadCount) {
   }
   EXPECT_EQ(iterations[0], iterations[1]);
   EXPECT_EQ(last[0].matrix(), last[1].matrix());
+}
+
+// ---------------------------------------------------------------------------------------------
+// The judgement, keyframe and re-seeding rules as functions of their inputs.
+
+SolverResult solved(double matched,
+                    const Eigen::Isometry3d& transform = Eigen::Isometry3d::Identity()) {
+  SolverResult s;
+  s.status = SolverStatus::kConverged;
+  s.matched_fraction = matched;
+  s.transform = transform;
+  return s;
+}
+
+Eigen::Isometry3d moved(double metres, double degrees) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.translation() << metres, 0.0, 0.0;
+  T.linear() = Eigen::AngleAxisd(degrees * M_PI / 180.0, Eigen::Vector3d::UnitY()).matrix();
+  return T;
+}
+
+TEST(Judgement, LostHardOrOkFromTheSolverAndTheMotionPerFrame) {
+  const OdometryParams p;  // lost below 10% matched, hard below 25%, 0.3 m / 20 deg per frame
+  const Eigen::Isometry3d still = Eigen::Isometry3d::Identity();
+  EXPECT_EQ(judgeTracking(solved(0.8), still, p).tracking, Tracking::kOk);
+  EXPECT_EQ(judgeTracking(solved(0.8), still, p).message, "");
+  SolverResult failed = solved(0.8);
+  failed.status = SolverStatus::kTooFewPoints;
+  EXPECT_EQ(judgeTracking(failed, still, p).tracking, Tracking::kLost);
+  const Judgement apart = judgeTracking(solved(0.05), still, p);
+  EXPECT_EQ(apart.tracking, Tracking::kLost);
+  EXPECT_NE(apart.message.find("do not overlap"), std::string::npos) << apart.message;
+  // The limits hold for the motion from the last frame, not for the registration's own
+  // transform (a keyframe may lie further back).
+  EXPECT_EQ(judgeTracking(solved(0.8, moved(0.4, 0)), still, p).tracking, Tracking::kOk);
+  EXPECT_EQ(judgeTracking(solved(0.8), moved(0.4, 0), p).tracking, Tracking::kLost);
+  EXPECT_EQ(judgeTracking(solved(0.8), moved(0.0, 25.0), p).tracking, Tracking::kLost);
+  EXPECT_EQ(judgeTracking(solved(0.2), still, p).tracking, Tracking::kHard);
+  SolverResult capped = solved(0.8);
+  capped.status = SolverStatus::kMaxIterations;
+  EXPECT_EQ(judgeTracking(capped, still, p).tracking, Tracking::kHard);
+}
+
+TEST(Keyframes, TakenWhenTheOverlapOrTheMotionFromTheKeyframeCrossesItsThreshold) {
+  OdometryParams p;
+  p.keyframe_matched_fraction = 0.6;
+  p.keyframe_translation = 0.05;
+  p.keyframe_rotation = 3.0;
+  const Judgement ok{Tracking::kOk, ""}, hard{Tracking::kHard, "weak overlap"};
+  EXPECT_FALSE(takesKeyframe(ok, solved(0.7, moved(0.04, 2.5)), p));
+  EXPECT_TRUE(takesKeyframe(ok, solved(0.5, moved(0.04, 2.5)), p));
+  EXPECT_TRUE(takesKeyframe(ok, solved(0.7, moved(0.06, 0.0)), p));
+  EXPECT_TRUE(takesKeyframe(ok, solved(0.7, moved(0.0, 3.5)), p));
+  EXPECT_TRUE(takesKeyframe(hard, solved(0.7), p));
+}
+
+TEST(Keyframes, ALostFrameReplacesTheReferenceOnlyWhenItShould) {
+  Params keyframe;
+  keyframe.odometry.reference = Reference::kKeyframe;
+  Params previous;
+  previous.odometry.reference = Reference::kPreviousFrame;
+  const SolverResult noise = solved(0.0), narrow = solved(0.08);
+  for (const Params& p : {keyframe, previous}) {
+    EXPECT_FALSE(replacesReference(narrow, 10, 3000, 2, p)) << "a blank frame never does";
+    EXPECT_TRUE(replacesReference(narrow, 3000, 10, 1, p)) << "a blank reference always is";
+    EXPECT_TRUE(replacesReference(noise, 3000, 3000, 2, p)) << "the second lost in a row";
+  }
+  // Keyframes: the first lost frame is followed by a try against the last good keyframe.
+  EXPECT_FALSE(replacesReference(narrow, 3000, 3000, 1, keyframe));
+  // Frame to frame: a narrowly lost frame re-seeds, a first frame of noise does not.
+  EXPECT_TRUE(replacesReference(narrow, 3000, 3000, 1, previous));
+  EXPECT_FALSE(replacesReference(noise, 3000, 3000, 1, previous));
+}
+
+TEST(Covariance, LostGrowthIsWhatTheCameraCanMoveUnseen) {
+  OdometryParams p;
+  p.lost_speed = 1.0;
+  p.lost_angular_speed = 90.0;
+  const Matrix6d g = lostGrowth(0.5, p);
+  EXPECT_NEAR(g(0, 0), std::pow(M_PI / 4.0, 2), 1e-12);  // 45 deg in 0.5 s
+  EXPECT_NEAR(g(5, 5), 0.25, 1e-12);                     // 0.5 m
+  EXPECT_EQ(g(0, 3), 0.0);
+  EXPECT_EQ(lostGrowth(-1.0, p), Matrix6d::Zero());
+  // Rotating a covariance into other axes keeps each block's trace.
+  Matrix6d c = Matrix6d::Zero();
+  c.diagonal() << 1e-4, 0, 0, 4e-6, 0, 0;
+  const Eigen::Matrix3d quarter = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).matrix();
+  const Matrix6d r = rotateCovariance(c, quarter);
+  EXPECT_NEAR(r(1, 1), 1e-4, 1e-15);
+  EXPECT_NEAR(r(4, 4), 4e-6, 1e-15);
+  Matrix6d bad = c;
+  bad(2, 2) = std::nan("");
+  EXPECT_EQ(sanitiseCovariance(bad), lostCovariance());
+}
+
+// ---------------------------------------------------------------------------------------------
+// Keyframe odometry on exact sequences.
+
+Params keyframeParams() {
+  Params p;
+  p.odometry.reference = Reference::kKeyframe;
+  return p;
+}
+
+// At 320x240: these tests run many registrations, also under the sanitizers.
+synth::SynthSequence exactSequence(int frames, synth::MotionKind motion) {
+  synth::SequenceOptions o;
+  o.frames = frames;
+  o.noise = false;
+  o.motion = motion;
+  o.camera = synth::scaledDefaultCamera(320, 240);
+  return synth::SynthSequence(o);
+}
+
+// Moving away from the start (xyz: along the camera's x at 1 cm per frame): the first frame is
+// the keyframe until a frame has moved beyond keyframe_translation from it, or until its overlap
+// drops below keyframe_matched_fraction; that frame is the next keyframe.
+TEST(Keyframes, ANewKeyframeIsTakenWhereTheMotionOrTheOverlapCrossesItsThreshold) {
+  const auto seq = exactSequence(16, synth::MotionKind::kXyz);
+  for (int criterion = 0; criterion < 2; ++criterion) {
+    Params p = keyframeParams();
+    p.odometry.keyframe_rotation = 90.0;
+    p.odometry.keyframe_translation = criterion == 0 ? 0.045 : 10.0;
+    p.odometry.keyframe_matched_fraction = criterion == 0 ? 0.0 : 0.9;
+    Odometry odo(p);
+    odo.reset(seq.poses()[0]);
+    int switched = -1;
+    for (int i = 0; i < seq.size() && switched < 0; ++i) {
+      const OdometryResult r = odo.process(seq.frame(i).toFrame());
+      ASSERT_NE(r.tracking, Tracking::kLost) << i << ": " << r.message;
+      EXPECT_EQ(r.frame_index, std::uint64_t(i));
+      EXPECT_EQ(r.keyframe_index, 0u) << i;
+      const double from_start = (seq.poses()[0].inverse() * seq.poses()[i]).translation().norm();
+      if (i > 0 && r.new_keyframe) {
+        switched = i;
+        if (criterion == 0) EXPECT_GT(from_start, 0.045 - 1.5e-3);
+        if (criterion == 1) EXPECT_LT(r.solver.matched_fraction, 0.9);
+      } else if (i > 0) {
+        if (criterion == 0) EXPECT_LT(from_start, 0.045 + 1.5e-3) << i;
+        if (criterion == 1) EXPECT_GE(r.solver.matched_fraction, 0.9) << i;
+      }
+    }
+    std::printf("  criterion %s: the first new keyframe is frame %d\n",
+                criterion == 0 ? "translation 4.5 cm" : "matched 90%", switched);
+    ASSERT_GT(switched, 1);
+    const OdometryResult next = odo.process(seq.frame(switched + 1).toFrame());
+    EXPECT_EQ(next.keyframe_index, std::uint64_t(switched));
+    EXPECT_LT(translationError(seq.poses()[switched + 1], next.pose), 1.5e-3 * (switched + 1));
+  }
+}
+
+// The frame after a lost one is registered to the keyframe in use before the loss, not to the
+// lost frame, and lands where it belongs.
+TEST(Keyframes, TheFrameAfterALostOneIsRegisteredToTheLastGoodKeyframe) {
+  const auto seq = exactSequence(6);
+  Odometry odo(keyframeParams());
+  odo.reset(seq.poses()[0]);
+  OdometryResult r;
+  for (int i = 0; i < 4; ++i) r = odo.process(seq.frame(i).toFrame());
+  const std::uint64_t keyframe = r.new_keyframe ? r.frame_index : r.keyframe_index;
+  Frame noise = seq.frame(4).toFrame();
+  cv::RNG rng(11);
+  rng.fill(noise.color, cv::RNG::UNIFORM, 0, 256);
+  rng.fill(noise.depth, cv::RNG::UNIFORM, 0.5, 4.0);
+  const OdometryResult lost = odo.process(noise);
+  EXPECT_EQ(lost.tracking, Tracking::kLost);
+  EXPECT_FALSE(lost.new_keyframe);
+  EXPECT_TRUE(lost.pose.isApprox(r.pose));
+  EXPECT_GT(lost.pose_covariance(3, 3), r.pose_covariance(3, 3)) << "the held pose may be wrong";
+  const OdometryResult back = odo.process(seq.frame(5).toFrame());
+  EXPECT_TRUE(back.tracking == Tracking::kOk || back.tracking == Tracking::kHard)
+      << toString(back.tracking) << ": " << back.message;
+  EXPECT_EQ(back.keyframe_index, keyframe);
+  EXPECT_LT(translationError(seq.poses()[5], back.pose), 1.5e-3 * 5);
+  EXPECT_LT(rotationErrorDeg(seq.poses()[5], back.pose), 0.1 * 5);
+  // Its covariance is the keyframe's plus one registration again: the loss left no trace.
+  EXPECT_LT(back.pose_covariance(3, 3), lost.pose_covariance(3, 3));
+}
+
+// A frame that no longer matches its keyframe well enough (here: lost below 85% matched, the
+// keyframe kept whatever the motion) is registered to the last tracked frame, which becomes
+// the keyframe: the camera moves on without a lost frame.
+TEST(Keyframes, AFrameThatFailsAgainstItsKeyframeFallsBackToTheLastTrackedFrame) {
+  const auto seq = exactSequence(30, synth::MotionKind::kXyz);
+  Params p = keyframeParams();
+  p.odometry.keyframe_translation = 10.0;
+  p.odometry.keyframe_rotation = 180.0;
+  p.odometry.keyframe_matched_fraction = 0.0;
+  p.odometry.lost_matched_fraction = 0.85;
+  p.odometry.hard_matched_fraction = 0.85;
+  Odometry odo(p);
+  odo.reset(seq.poses()[0]);
+  int fell_back = 0;
+  for (int i = 0; i < seq.size(); ++i) {
+    const OdometryResult r = odo.process(seq.frame(i).toFrame());
+    ASSERT_NE(r.tracking, Tracking::kLost) << "frame " << i << ": " << r.message;
+    if (r.fell_back_to_previous) {
+      ++fell_back;
+      EXPECT_EQ(r.keyframe_index, std::uint64_t(i - 1));
+    }
+    EXPECT_LT(translationError(seq.poses()[i], r.pose), 1.5e-3 * (i + 1)) << i;
+  }
+  std::printf("  %d of %d frames fell back to the last tracked frame\n", fell_back, seq.size());
+  EXPECT_GE(fell_back, 1);
+}
+
+// A still camera: each frame is registered to the same keyframe, so the pose covariance is the
+// keyframe's plus one registration's, frame after frame; frame to frame it is a sum that grows
+// with every frame.
+TEST(Keyframes, PoseCovarianceGrowsPerKeyframeNotPerFrame) {
+  const auto seq = exactSequence(12, synth::MotionKind::kStill);
+  double first[2] = {0, 0}, last[2] = {0, 0};
+  for (int k = 0; k < 2; ++k) {
+    Params p = keyframeParams();
+    if (k == 1) p.odometry.reference = Reference::kPreviousFrame;
+    Odometry odo(p);
+    for (int i = 0; i < seq.size(); ++i) {
+      const OdometryResult r = odo.process(seq.frame(i).toFrame());
+      const double trace = r.pose_covariance.trace();
+      if (i == 1) first[k] = trace;
+      last[k] = trace;
+    }
+  }
+  std::printf(
+      "  pose covariance trace, frame 1 -> 11: keyframe %.3g -> %.3g, previous frame "
+      "%.3g -> %.3g\n",
+      first[0], last[0], first[1], last[1]);
+  EXPECT_LT(last[0], 1.5 * first[0]);
+  EXPECT_GT(last[1], 8.0 * first[1]);
 }
 
 }  // namespace

@@ -150,7 +150,8 @@ TEST(LengthScale, GradientMatchesCentralDifferenceOfJ) {
   }
 }
 
-// ---- search direction ----------------------------------------------------------------------------
+// ---- search direction
+// ----------------------------------------------------------------------------
 TEST(ConjugateDirection, PolakRibierePlusWithRestarts) {
   const Vector6d g0 = (Vector6d() << 1, 0, 0, 0, 0, 0).finished();
   const Vector6d g1 = (Vector6d() << 0.5, 0.5, 0, 0, 0, 0).finished();
@@ -174,6 +175,23 @@ TEST(ConjugateDirection, PolakRibierePlusWithRestarts) {
 }
 
 // ---- whole registrations ------------------------------------------------------------------------
+// Linear convergence taken at once: aligned steps shrinking by rho are extended by 1/(1-rho),
+// rho capped; anything else is left as Gauss-Newton gave it.
+TEST(Extrapolation, ExtendsShrinkingAlignedStepsOnly) {
+  Vector6d previous;
+  previous << 1e-3, -2e-3, 0.5e-3, 4e-3, 0.0, -1e-3;
+  const Vector6d step = 0.4 * previous;
+  EXPECT_TRUE(extrapolatedStep(step, previous, 0.5).isApprox(step / 0.6));
+  EXPECT_TRUE(extrapolatedStep(0.8 * previous, previous, 0.5).isApprox(0.8 * previous / 0.5));
+  EXPECT_EQ(extrapolatedStep(step, previous, 0.0), step);                      // off
+  EXPECT_EQ(extrapolatedStep(-step, previous, 0.5), -step);                    // turned back
+  EXPECT_EQ(extrapolatedStep(1.5 * previous, previous, 0.5), 1.5 * previous);  // growing
+  EXPECT_EQ(extrapolatedStep(step, Vector6d::Zero(), 0.5), step);  // first step of a level
+  Vector6d sideways = step;
+  sideways[1] = -sideways[1];  // cosine with previous well below 0.9
+  EXPECT_EQ(extrapolatedStep(sideways, previous, 0.5), sideways);
+}
+
 TEST(Align, IdenticalCloudsGiveIdentityInZeroIterations) {
   SolverParams p = paperParams().solver;
   const LabelledCloud X = test::randomCloud(1500, 21, 0.5f);
@@ -193,8 +211,8 @@ TEST(Align, IdenticalCloudsGiveIdentityInZeroIterations) {
 
 TEST(Align, RecoversSmallMotionsOfARandomSurfaceCloud) {
   const Vector6d motions[] = {
-      (Vector6d() << 0, 0, 0, 0.03, -0.02, 0.02).finished(),           // pure translation
-      (Vector6d() << 0.04, -0.03, 0.05, 0, 0, 0).finished(),           // pure rotation (~3.9 deg)
+      (Vector6d() << 0, 0, 0, 0.03, -0.02, 0.02).finished(),             // pure translation
+      (Vector6d() << 0.04, -0.03, 0.05, 0, 0, 0).finished(),             // pure rotation (~3.9 deg)
       (Vector6d() << 0.03, 0.02, -0.04, -0.03, 0.02, 0.025).finished(),  // both
   };
   for (EllPolicy policy : {EllPolicy::kAdaptive, EllPolicy::kFixedSchedule}) {
@@ -208,7 +226,8 @@ TEST(Align, RecoversSmallMotionsOfARandomSurfaceCloud) {
       const PreparedCloud fx = prepareCloud(X, p), mz = prepareCloud(Z, p);
       const SolverResult r = align(fx, mz, Eigen::Isometry3d::Identity(), p);
       const Vector6d err = logSE3(truth.inverse() * r.transform);
-      EXPECT_LT(err.tail<3>().norm(), 1e-3) << "policy " << int(policy) << " iterations " << r.iterations;
+      EXPECT_LT(err.tail<3>().norm(), 1e-3)
+          << "policy " << int(policy) << " iterations " << r.iterations;
       EXPECT_LT(err.head<3>().norm() * 180 / M_PI, 0.1) << "policy " << int(policy);
     }
   }
