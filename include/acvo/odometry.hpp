@@ -136,6 +136,13 @@ class Odometry {
     Eigen::Isometry3d to_keyframe = Eigen::Isometry3d::Identity();  // camera -> keyframe camera
   };
   struct Registration;
+  // The steps of process(), in order.
+  std::shared_ptr<PreparedCloud> buildCloud(const Frame& frame, OdometryResult& r);
+  void start(OdometryResult& r, const std::shared_ptr<PreparedCloud>& current);
+  // To the keyframe from the prior, then (lost) to the last tracked frame; fills r's solver
+  // figures and judgement.
+  Registration registerFrame(OdometryResult& r, const PreparedCloud& current,
+                             const Eigen::Isometry3d& prior);
   // Builds the search grids a cloud registered to needs (prepareReference), timed into r.
   void asReference(OdometryResult& r, PreparedCloud& cloud);
   Registration registerTo(const Tracked& reference, const PreparedCloud& current,

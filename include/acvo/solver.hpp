@@ -2,6 +2,7 @@
 // labelled clouds over SE(3), with a fixed length-scale schedule or the adaptive one.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -9,6 +10,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "acvo/cross_kernel.hpp"
 #include "acvo/kernel.hpp"
 #include "acvo/params.hpp"
 #include "acvo/se3.hpp"
@@ -81,6 +83,51 @@ Vector6d conjugateDirection(const Vector6d& g, const Vector6d& g_prev, const Vec
 // and is shorter by a ratio rho < 1, the rest of that geometric series is taken at once:
 // step / (1 - min(rho, max_ratio)). `step` itself otherwise, and when max_ratio is 0.
 Vector6d extrapolatedStep(const Vector6d& step, const Vector6d& previous, double max_ratio);
+
+// The adaptive length-scale of one registration (A-CVO, docs/method.md): ell and its upper
+// bound, reset per frame; `reductions` counts the times ell reached the bound and it shrank.
+struct LengthScale {
+  double ell = 0.0, ell_max = 0.0;
+  int reductions = 0;
+  bool pinned(const SolverParams& p) const;  // at ell_min or at the (shrunk) ell_max
+};
+
+// dJ/dell of J = |f_X - h.f_Z|^2 from the self-kernel sums of both clouds and the cross sums
+// of one iteration at `ell`, divided by nnz(Axx) + nnz(Ayy) - 2 nnz(A) when that is positive.
+double lengthScaleGradient(const SelfSums& xx, const SelfSums& yy, const CrossSums& xy, double ell);
+
+// One step of ell along -gradient (descent; `reference`: +gradient, the authors' code); on
+// reaching ell_max the bound shrinks by ell_reduction (never below ell_min) and ell takes it;
+// ell never below ell_min. A gradient that is not finite changes nothing. Returns whether ell
+// ends pinned at a bound.
+bool updateLengthScale(LengthScale& ls, double gradient, const SolverParams& p);
+
+// The stall rule (SolverParams::stall_iterations): remembers the best objective seen at the
+// current length-scale; stalls() says when `patience` iterations in a row at that length-scale
+// brought nothing better (best() is then the transform to keep). Never stalls for patience 0.
+class StallTracker {
+ public:
+  explicit StallTracker(int patience) : patience_(patience) {}
+  bool stalls(double ell, double F, const Eigen::Isometry3d& T);
+  const Eigen::Isometry3d& best() const { return best_T_; }
+
+ private:
+  int patience_;
+  double ell_ = -1.0, best_F_ = -INFINITY;
+  Eigen::Isometry3d best_T_ = Eigen::Isometry3d::Identity();
+  int since_best_ = 0;
+};
+
+// The direction of each iteration from its gradient: the gradient itself, or conjugate
+// gradient (conjugateDirection) from the second iteration on.
+class SearchState {
+ public:
+  Vector6d next(const Vector6d& gradient, SearchDirection kind);
+
+ private:
+  bool started_ = false;
+  Vector6d g_prev_ = Vector6d::Zero(), d_prev_ = Vector6d::Zero();
+};
 
 // The length-scale for a fixed-schedule iteration (CVO: 0.15, 0.10 after 2, 0.06 after 9,
 // 0.03 after 19).

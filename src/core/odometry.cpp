@@ -197,7 +197,6 @@ Odometry::Registration Odometry::registerTo(const Tracked& reference, const Prep
 
 OdometryResult Odometry::process(const Frame& frame,
                                  const std::optional<Eigen::Isometry3d>& motion_guess) {
-  using Clock = std::chrono::steady_clock;
   OdometryResult r;
   r.pose = pose_;
   r.pose_covariance = pose_covariance_;
@@ -208,7 +207,28 @@ OdometryResult Odometry::process(const Frame& frame,
     r.motion_covariance = lostCovariance();
     return r;
   }
+  const std::shared_ptr<PreparedCloud> current = buildCloud(frame, r);
+  if (!keyframe_) {
+    start(r, current);
+    return r;
+  }
+  r.interval = frame.stamp - last_->cloud->cloud.stamp;
+  const Eigen::Isometry3d prior =
+      motion_guess ? *motion_guess
+      : params_.odometry.initial_guess == InitialGuess::kConstantVelocity
+          ? motionPrior(velocity_, velocity_interval_, r.interval)
+          : Eigen::Isometry3d::Identity();
+  Registration reg = registerFrame(r, *current, prior);
+  if (reg.judgement.tracking == Tracking::kLost) {
+    lost(r, reg, current, frame.stamp);
+  } else {
+    tracked(r, std::move(reg), current);
+  }
+  return r;
+}
 
+std::shared_ptr<PreparedCloud> Odometry::buildCloud(const Frame& frame, OdometryResult& r) {
+  using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
   std::shared_ptr<PreparedCloud> current;
   // Frame to frame, every frame becomes the reference: its search grids are built with it.
@@ -224,35 +244,32 @@ OdometryResult Odometry::process(const Frame& frame,
   r.ms_prepare = current->ms_prepare;
   r.cloud = std::shared_ptr<const LabelledCloud>(current, &current->cloud);
   r.frame_index = frames_++;
+  return current;
+}
 
-  if (!keyframe_) {
-    lost_in_a_row_ = 0;
-    asReference(r, *current);
-    keyframe_ = last_ =
-        Tracked{current, r.frame_index, pose_, pose_covariance_, Eigen::Isometry3d::Identity()};
-    r.tracking = Tracking::kFirstFrame;
-    r.keyframe_index = r.frame_index;
-    r.new_keyframe = true;
-    return r;
-  }
+void Odometry::start(OdometryResult& r, const std::shared_ptr<PreparedCloud>& current) {
+  lost_in_a_row_ = 0;
+  asReference(r, *current);
+  keyframe_ = last_ =
+      Tracked{current, r.frame_index, pose_, pose_covariance_, Eigen::Isometry3d::Identity()};
+  r.tracking = Tracking::kFirstFrame;
+  r.keyframe_index = r.frame_index;
+  r.new_keyframe = true;
+}
 
-  r.interval = frame.stamp - last_->cloud->cloud.stamp;
-  const Eigen::Isometry3d prior =
-      motion_guess ? *motion_guess
-      : params_.odometry.initial_guess == InitialGuess::kConstantVelocity
-          ? motionPrior(velocity_, velocity_interval_, r.interval)
-          : Eigen::Isometry3d::Identity();
+Odometry::Registration Odometry::registerFrame(OdometryResult& r, const PreparedCloud& current,
+                                               const Eigen::Isometry3d& prior) {
   const bool last_is_keyframe = last_->index == keyframe_->index;
   // From the keyframe: where the last tracked frame was, then the prior's motion.
   Registration reg =
-      registerTo(*keyframe_, *current, last_is_keyframe ? prior : last_->to_keyframe * prior);
+      registerTo(*keyframe_, current, last_is_keyframe ? prior : last_->to_keyframe * prior);
   r.ms_registration = reg.solver.ms_total;
 
   // Failed against the keyframe: the last tracked frame, closer in time, may still overlap.
   if (reg.judgement.tracking == Tracking::kLost && !last_is_keyframe &&
-      int(current->size()) >= params_.solver.min_points) {
+      int(current.size()) >= params_.solver.min_points) {
     asReference(r, *last_->cloud);
-    Registration to_last = registerTo(*last_, *current, prior);
+    Registration to_last = registerTo(*last_, current, prior);
     r.ms_registration += to_last.solver.ms_total;
     if (to_last.judgement.tracking != Tracking::kLost) {
       keyframe_ = last_;
@@ -266,17 +283,12 @@ OdometryResult Odometry::process(const Frame& frame,
   r.solver = reg.solver;
   r.tracking = reg.judgement.tracking;
   r.message = reg.judgement.message;
-  if (r.tracking == Tracking::kLost) {
-    if (reg.solver.status == SolverStatus::kTooFewPoints) {
-      r.message += int(r.moving_points) < params_.solver.min_points
-                       ? ": this frame has " + whyTooFewPoints(r.cloud_stats, params_.selection)
-                       : ": the reference frame has too few points";
-    }
-    lost(r, reg, current, frame.stamp);
-  } else {
-    tracked(r, std::move(reg), current);
+  if (reg.solver.status == SolverStatus::kTooFewPoints) {
+    r.message += int(r.moving_points) < params_.solver.min_points
+                     ? ": this frame has " + whyTooFewPoints(r.cloud_stats, params_.selection)
+                     : ": the reference frame has too few points";
   }
-  return r;
+  return reg;
 }
 
 void Odometry::tracked(OdometryResult& r, Registration reg,

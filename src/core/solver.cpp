@@ -133,6 +133,18 @@ Eigen::Isometry3d coarseAlign(const PreparedCloud& fixed, const PreparedCloud& m
   return T;
 }
 
+// The start of the main stage: the coarse stage's result when the main stage's own objective
+// (at its first length-scale) is kCoarseGain times higher there than at the guess, the guess
+// otherwise (the coarse stage sees a subset and a blurred objective).
+Eigen::Isometry3d coarseStart(CrossKernel& kernel, const PreparedCloud& fixed,
+                              const PreparedCloud& moving, const Eigen::Isometry3d& guess,
+                              const SolverParams& p, int* iterations) {
+  const Eigen::Isometry3d coarse = coarseAlign(fixed, moving, guess, p, iterations);
+  const double ell0 = p.ell_policy == EllPolicy::kAdaptive ? p.ell_init : scheduledEll(0);
+  const double F_guess = kernel.evaluate(guess, ell0).F;
+  return kernel.evaluate(coarse, ell0).F > kCoarseGain * F_guess ? coarse : guess;
+}
+
 // Every k-th point of a cloud (k = size / count, at least 1), labels with them.
 PreparedCloud strided(const PreparedCloud& cloud, int count) {
   PreparedCloud subset;
@@ -252,6 +264,61 @@ double solveStep(double B, double C, double D, double E, double min_step, double
   return std::min(t, max_step);
 }
 
+bool LengthScale::pinned(const SolverParams& p) const {
+  return ell <= p.ell_min || ell >= ell_max;
+}
+
+double lengthScaleGradient(const SelfSums& xx, const SelfSums& yy, const CrossSums& xy,
+                           double ell) {
+  double grad = (xx.sum_d2 + yy.sum_d2 - 2.0 * xy.F_d2) / (ell * ell * ell);
+  // Normalised by the pairs that entered it, as the authors' code does.
+  const double denom = double(xx.nnz + yy.nnz - 2 * xy.nnz);
+  if (denom > 0.0) grad /= denom;
+  return grad;
+}
+
+bool updateLengthScale(LengthScale& ls, double gradient, const SolverParams& p) {
+  if (!std::isfinite(gradient)) return false;
+  ls.ell = p.ell_update == EllUpdate::kReference ? ls.ell + p.ell_step * gradient
+                                                 : ls.ell - p.ell_step * gradient;
+  if (ls.ell >= ls.ell_max) {
+    // ell_max never drops below ell_min: past that the bound would shrink forever.
+    ls.ell_max = std::max(ls.ell_max * p.ell_reduction, p.ell_min);
+    ++ls.reductions;
+    ls.ell = ls.ell_max;
+  }
+  ls.ell = std::max(ls.ell, p.ell_min);
+  return ls.pinned(p);
+}
+
+bool StallTracker::stalls(double ell, double F, const Eigen::Isometry3d& T) {
+  if (patience_ <= 0) return false;
+  if (ell != ell_) {
+    ell_ = ell;
+    best_F_ = F;
+    best_T_ = T;
+    since_best_ = 0;
+  } else if (F > best_F_) {
+    best_F_ = F;
+    best_T_ = T;
+    since_best_ = 0;
+  } else if (++since_best_ >= patience_) {
+    return true;
+  }
+  return false;
+}
+
+Vector6d SearchState::next(const Vector6d& g, SearchDirection kind) {
+  const bool first = !started_;
+  started_ = true;
+  const Vector6d d = kind == SearchDirection::kConjugateGradient && !first
+                         ? conjugateDirection(g, g_prev_, d_prev_)
+                         : g;
+  g_prev_ = g;
+  d_prev_ = d;
+  return d;
+}
+
 double scheduledEll(int iteration) {
   if (iteration < 2) return 0.15;
   if (iteration < 9) return 0.10;
@@ -291,34 +358,21 @@ SolverResult align(const PreparedCloud& fixed, const PreparedCloud& moving,
   }
 
   CrossKernel kernel(fixed, moving, p);
+  const bool adaptive = p.ell_policy == EllPolicy::kAdaptive;
   Eigen::Isometry3d T = guess;
-  const bool adaptive_policy = p.ell_policy == EllPolicy::kAdaptive;
   if (p.coarse_ell > 0.0 && p.coarse_iterations > 0 && !fixed.coarse_grid.empty()) {
     const auto t0 = Clock::now();
-    const Eigen::Isometry3d T_coarse = coarseAlign(fixed, moving, T, p, &result.coarse_iterations);
-    // The coarse stage sees a subset and a blurred objective: keep its answer only when the
-    // main stage's own objective agrees that it is a better start than the guess.
-    const double ell0 = adaptive_policy ? p.ell_init : scheduledEll(0);
-    const double F_guess = kernel.evaluate(guess, ell0).F;
-    if (kernel.evaluate(T_coarse, ell0).F > kCoarseGain * F_guess) T = T_coarse;
+    T = coarseStart(kernel, fixed, moving, guess, p, &result.coarse_iterations);
     result.ms_neighbours += msSince(t0);
   }
 
-  double ell = p.ell_init, ell_max = p.ell_max;
-  const bool adaptive = p.ell_policy == EllPolicy::kAdaptive;
-  const bool reference = p.ell_update == EllUpdate::kReference;
+  LengthScale ls{p.ell_init, p.ell_max};
+  SearchState direction;
+  StallTracker stall(p.stall_iterations);
   result.status = SolverStatus::kMaxIterations;
   int it = 0;
-  double used_ell = ell;
-  const bool conjugate = p.direction == SearchDirection::kConjugateGradient;
-  Vector6d g_prev = Vector6d::Zero(), d_prev = Vector6d::Zero();
-  // Stagnation at an unchanged length-scale (SolverParams::stall_iterations): the best
-  // transform seen at this length-scale and how many iterations ago it was found.
-  double stall_ell = -1.0, best_F = -INFINITY;
-  Eigen::Isometry3d best_T = T;
-  int stalled = 0;
   for (; it < p.max_iterations; ++it) {
-    used_ell = adaptive ? ell : scheduledEll(it);
+    const double used_ell = adaptive ? ls.ell : scheduledEll(it);
     auto t0 = Clock::now();
     const CrossSums& s = kernel.evaluate(T, used_ell);
     result.ms_neighbours += msSince(t0);
@@ -331,29 +385,17 @@ SolverResult align(const PreparedCloud& fixed, const PreparedCloud& moving,
       break;
     }
     // A fixed schedule still has coarser stages to leave: only its last one can stall.
-    if (p.stall_iterations > 0 && (adaptive || used_ell == scheduledEll(p.max_iterations))) {
-      if (used_ell != stall_ell) {
-        stall_ell = used_ell;
-        best_F = s.F;
-        best_T = T;
-        stalled = 0;
-      } else if (s.F > best_F) {
-        best_F = s.F;
-        best_T = T;
-        stalled = 0;
-      } else if (++stalled >= p.stall_iterations) {
-        T = best_T;
-        result.stalled = true;
-        result.status = SolverStatus::kConverged;
-        break;
-      }
+    if ((adaptive || used_ell == scheduledEll(p.max_iterations)) &&
+        stall.stalls(used_ell, s.F, T)) {
+      T = stall.best();
+      result.stalled = true;
+      result.status = SolverStatus::kConverged;
+      break;
     }
 
     Vector6d g;
     g << s.omega, s.v;
-    const Vector6d xi = conjugate && it > 0 ? conjugateDirection(g, g_prev, d_prev) : g;
-    g_prev = g;
-    d_prev = xi;
+    const Vector6d xi = direction.next(g, p.direction);
     t0 = Clock::now();
     // The step-size model holds for any direction: its root is a line search along xi.
     const StepSums st = kernel.stepSums(xi.head<3>(), xi.tail<3>());
@@ -365,31 +407,20 @@ SolverResult align(const PreparedCloud& fixed, const PreparedCloud& moving,
       break;
     }
     T = normalized(dT * T);
-    IterationTrace trace{used_ell, ell_max, step, step * xi.norm(), s.F, s.nnz};
+    IterationTrace trace{used_ell, ls.ell_max, step, step * xi.norm(), s.F, s.nnz};
 
     if (adaptive) {
       t0 = Clock::now();
-      // dJ/dl with J = |f_X - h.f_Z|^2 (method.md §4), from the pairs of this iteration.
-      const SelfSums xx = selfKernelSums(fixed, ell, p);
-      const SelfSums yy = selfKernelSums(moving, ell, p, reference ? int(fixed.size()) : 0);
-      double grad = (xx.sum_d2 + yy.sum_d2 - 2.0 * s.F_d2) / (ell * ell * ell);
-      const double denom = double(xx.nnz + yy.nnz - 2 * s.nnz);
-      if (denom > 0.0) grad /= denom;
-      if (std::isfinite(grad)) {
-        ell = reference ? ell + p.ell_step * grad : ell - p.ell_step * grad;
-        if (ell >= ell_max) {
-          // ell_max never drops below ell_min: past that the bound would shrink forever.
-          ell_max = std::max(ell_max * p.ell_reduction, p.ell_min);
-          ++result.ell_max_reductions;
-          ell = ell_max;
-        }
-        ell = std::max(ell, p.ell_min);
-        const bool pinned = ell <= p.ell_min || ell >= ell_max;
-        result.ell_bound_iterations += pinned ? 1 : 0;
+      // dJ/dl from the pairs of this iteration, at the length-scale they were found with.
+      const bool reference = p.ell_update == EllUpdate::kReference;
+      const SelfSums xx = selfKernelSums(fixed, ls.ell, p);
+      const SelfSums yy = selfKernelSums(moving, ls.ell, p, reference ? int(fixed.size()) : 0);
+      if (updateLengthScale(ls, lengthScaleGradient(xx, yy, s, ls.ell), p)) {
+        ++result.ell_bound_iterations;
       }
       result.ms_ell += msSince(t0);
     }
-    trace.ell_max = ell_max;
+    trace.ell_max = ls.ell_max;
     result.trace.push_back(trace);
     if (step * xi.norm() < p.eps_transform) {
       result.status = SolverStatus::kConverged;
@@ -397,15 +428,16 @@ SolverResult align(const PreparedCloud& fixed, const PreparedCloud& moving,
       break;
     }
   }
+  result.ell_max_reductions = ls.reductions;
   result.iterations = it;
   result.transform = T;
   result.list_builds = kernel.candidateListBuilds();
 
   // Final figures at the returned transform.
-  const double final_ell = adaptive ? ell : scheduledEll(it);
+  const double final_ell = adaptive ? ls.ell : scheduledEll(it);
   const CrossSums& s = kernel.evaluate(T, final_ell);
   result.ell = final_ell;
-  result.ell_at_bound = adaptive && (ell <= p.ell_min || ell >= ell_max);
+  result.ell_at_bound = adaptive && ls.pinned(p);
   result.nnz = std::size_t(s.nnz);
   result.matched_fraction = double(s.matched) / double(std::max<std::size_t>(moving.size(), 1));
   result.objective = s.F;

@@ -192,6 +192,76 @@ TEST(Extrapolation, ExtendsShrinkingAlignedStepsOnly) {
   EXPECT_EQ(extrapolatedStep(sideways, previous, 0.5), sideways);
 }
 
+// The length-scale update of A-CVO: descent along dJ/dell, the bound shrinking on contact and
+// never below ell_min; ascent with the authors' sign.
+TEST(LengthScale, DescendsShrinksTheBoundOnContactAndStaysAboveTheMinimum) {
+  SolverParams p = paperParams().solver;  // ell_min 0.0391, ell_max 0.15, step 0.3, factor 0.7
+  LengthScale ls{0.1, p.ell_max};
+  EXPECT_FALSE(updateLengthScale(ls, 0.05, p));  // 0.1 - 0.3 * 0.05
+  EXPECT_DOUBLE_EQ(ls.ell, 0.085);
+  EXPECT_TRUE(updateLengthScale(ls, -1.0, p));  // to 0.385: the bound shrinks to 0.105
+  EXPECT_DOUBLE_EQ(ls.ell_max, 0.15 * 0.7);
+  EXPECT_DOUBLE_EQ(ls.ell, ls.ell_max);
+  EXPECT_EQ(ls.reductions, 1);
+  EXPECT_TRUE(updateLengthScale(ls, 10.0, p));  // far below: ell_min
+  EXPECT_DOUBLE_EQ(ls.ell, p.ell_min);
+  for (int k = 0; k < 20; ++k) updateLengthScale(ls, -1.0, p);
+  EXPECT_DOUBLE_EQ(ls.ell_max, p.ell_min) << "the bound never drops below ell_min";
+  LengthScale before = ls;
+  EXPECT_FALSE(updateLengthScale(ls, std::nan(""), p));
+  EXPECT_EQ(ls.ell, before.ell);
+  p.ell_update = EllUpdate::kReference;
+  LengthScale up{0.1, 0.15};
+  updateLengthScale(up, 0.05, p);
+  EXPECT_DOUBLE_EQ(up.ell, 0.115);
+}
+
+TEST(LengthScale, GradientIsNormalisedByThePairsThatEnterIt) {
+  SelfSums xx, yy;
+  CrossSums xy;
+  xx.sum_d2 = 2.0, yy.sum_d2 = 3.0, xy.F_d2 = 1.0;
+  xx.nnz = 10, yy.nnz = 12, xy.nnz = 4;
+  EXPECT_DOUBLE_EQ(lengthScaleGradient(xx, yy, xy, 0.5), (2.0 + 3.0 - 2.0) / 0.125 / 14.0);
+  xy.nnz = 20;  // a non-positive count leaves the sum as it is
+  EXPECT_DOUBLE_EQ(lengthScaleGradient(xx, yy, xy, 0.5), 3.0 / 0.125);
+}
+
+TEST(StallRule, StopsAfterPatienceIterationsWithoutABetterObjectiveAtOneLengthScale) {
+  StallTracker stall(3);
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  auto at = [&](double x) {
+    T.translation().x() = x;
+    return T;
+  };
+  EXPECT_FALSE(stall.stalls(0.1, 5.0, at(0.0)));
+  EXPECT_FALSE(stall.stalls(0.1, 6.0, at(1.0)));  // best so far
+  EXPECT_FALSE(stall.stalls(0.1, 5.5, at(2.0)));
+  EXPECT_FALSE(stall.stalls(0.1, 5.9, at(3.0)));
+  EXPECT_TRUE(stall.stalls(0.1, 4.0, at(4.0)));
+  EXPECT_EQ(stall.best().translation().x(), 1.0);
+  // A new length-scale starts the count again.
+  StallTracker fresh(2);
+  EXPECT_FALSE(fresh.stalls(0.1, 5.0, at(0.0)));
+  EXPECT_FALSE(fresh.stalls(0.1, 4.0, at(1.0)));
+  EXPECT_FALSE(fresh.stalls(0.05, 3.0, at(2.0)));
+  EXPECT_FALSE(fresh.stalls(0.05, 2.0, at(3.0)));
+  EXPECT_TRUE(fresh.stalls(0.05, 1.0, at(4.0)));
+  EXPECT_EQ(fresh.best().translation().x(), 2.0);
+  StallTracker off(0);
+  for (int k = 0; k < 10; ++k) EXPECT_FALSE(off.stalls(0.1, 1.0, at(k)));
+}
+
+TEST(SearchState, GradientFirstThenConjugate) {
+  Vector6d g1, g2;
+  g1 << 1, 0, 0, 0, 1, 0;
+  g2 << 0.5, 0.5, 0, 0, 0.5, 0;
+  SearchState cg, plain;
+  EXPECT_EQ(cg.next(g1, SearchDirection::kConjugateGradient), g1);
+  EXPECT_EQ(cg.next(g2, SearchDirection::kConjugateGradient), conjugateDirection(g2, g1, g1));
+  EXPECT_EQ(plain.next(g1, SearchDirection::kGradient), g1);
+  EXPECT_EQ(plain.next(g2, SearchDirection::kGradient), g2);
+}
+
 TEST(Align, IdenticalCloudsGiveIdentityInZeroIterations) {
   SolverParams p = paperParams().solver;
   const LabelledCloud X = test::randomCloud(1500, 21, 0.5f);
