@@ -333,6 +333,26 @@ TEST(Keyframes, ALostFrameReplacesTheReferenceOnlyWhenItShould) {
   EXPECT_FALSE(replacesReference(noise, 3000, 3000, 1, previous));
 }
 
+TEST(Covariance, OfAMotionIsTheScaledInverseCurvatureAndNoneWhenADirectionIsFree) {
+  SolverResult s = solved(0.8);
+  s.hessian = -Matrix6d::Identity() * 4.0;
+  s.hessian(5, 5) = -16.0;
+  s.nnz = 6000;
+  const SolverParams coarse_to_fine;
+  const std::optional<Matrix6d> c = motionCovariance(s, coarse_to_fine, 2.0, 3000);
+  ASSERT_TRUE(c);
+  EXPECT_NEAR((*c)(0, 0), 0.5, 1e-12);  // 2 / 4
+  EXPECT_NEAR((*c)(5, 5), 0.125, 1e-12);
+  // The paper's policies: times the kernel pairs per moving point (2 here).
+  const std::optional<Matrix6d> paper = motionCovariance(s, paperParams().solver, 2.0, 3000);
+  ASSERT_TRUE(paper);
+  EXPECT_NEAR((*paper)(0, 0), 1.0, 1e-12);
+  s.hessian(2, 2) = 0.0;  // nothing constrains rotation about z
+  EXPECT_FALSE(motionCovariance(s, coarse_to_fine, 2.0, 3000));
+  s.hessian(2, 2) = std::nan("");
+  EXPECT_FALSE(motionCovariance(s, coarse_to_fine, 2.0, 3000));
+}
+
 TEST(Covariance, LostGrowthIsWhatTheCameraCanMoveUnseen) {
   OdometryParams p;
   p.lost_speed = 1.0;
