@@ -1,7 +1,7 @@
 // The per-iteration work of the solver: the cross kernel A = K(X, T Z) with its sparsified pairs,
 // the ascent direction (omega, v), the 4th-order step-size sums B..E, the length-scale terms and
 // the curvature at the optimum; plus the self-kernel sums of one cloud. Split from the solver's
-// control flow so that each formula can be tested on its own (method.md §2-§4).
+// control flow so that each formula can be tested on its own (docs/method.md §2-§4).
 #pragma once
 
 #include <cstdint>

@@ -1,5 +1,5 @@
 // The kernel a_ij, its sparsification, and the per-cloud structures the solver reuses:
-// a uniform voxel grid for the cross-pair search and the self-kernel pairs (method.md §2, §4).
+// a uniform voxel grid for the cross-pair search and the self-kernel pairs (docs/method.md §2, §4).
 #pragma once
 
 #include <cmath>
@@ -14,7 +14,7 @@
 namespace acvo {
 
 // Smallest s* such that |g(s) - L_n(s)| <= tol for all s >= s*, where g(s) = exp(-1/(2 s^2))
-// and L_n its expansion about s = infinity truncated at order n in 1/s (method.md §5).
+// and L_n its expansion about s = infinity truncated at order n in 1/s (docs/method.md §5).
 // Returns g(s*), the sparsification threshold divided by sigma^2.
 // (4, 1e-3) -> 0.8315, (6, 1e-3) -> 0.6694.
 double sparsificationThreshold(int order, double tolerance);

@@ -1,5 +1,5 @@
 // A labelled semi-dense point cloud: points in the camera optical frame + 5-D labels
-// [H, S, V, gx, gy] (method.md §1).
+// [H, S, V, gx, gy] (docs/method.md §1).
 #pragma once
 
 #include <array>

@@ -1,4 +1,4 @@
-// DSO-style semi-dense pixel selection with a Canny fallback (method.md §1).
+// DSO-style semi-dense pixel selection with a Canny fallback (docs/method.md §1).
 #pragma once
 
 #include <vector>

@@ -1,4 +1,4 @@
-// One A-CVO / CVO registration (method.md §3-§4): maximise the RKHS inner product of two
+// One A-CVO / CVO registration (docs/method.md §3-§4): maximise the RKHS inner product of two
 // labelled clouds over SE(3), with a fixed length-scale schedule or the adaptive one.
 #pragma once
 

@@ -299,7 +299,7 @@ StepSums CrossKernel::stepSums(const Eigen::Vector3d& omega_d, const Eigen::Vect
       const Eigen::Vector3f x3 = omega.cross(x2);
       const Eigen::Vector3f x4 = omega.cross(x3);
       // Exponent of a_ij(t) = a_ij exp(beta t + gamma t^2 + delta t^3 + eps t^4 + O(t^5)), from
-      // x - y(t) = d + t x1 - t^2/2 x2 + t^3/6 x3 - t^4/24 x4 with d = x - y. (method.md writes
+      // x - y(t) = d + t x1 - t^2/2 x2 + t^3/6 x3 - t^4/24 x4 with d = x - y. (the paper writes
       // these terms without exp's factorials; with them, C, D and E are the Taylor coefficients
       // of F, which the tests check against finite differences.)
       const double g_const = x1.squaredNorm();

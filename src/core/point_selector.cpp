@@ -1,4 +1,4 @@
-// DSO-style semi-dense selection (method.md §1).
+// DSO-style semi-dense selection (docs/method.md §1).
 //
 // Reading order: candidate maps (selection_maps.cpp) -> one selection pass for a cell size `pot`
 // -> adapting pot to the target count -> Canny fallback -> depth check.

@@ -1,4 +1,4 @@
-// The candidate maps of the DSO-style selector (method.md §1): for each level of a 3-level
+// The candidate maps of the DSO-style selector (docs/method.md §1): for each level of a 3-level
 // pyramid, |grad I|^2 where it exceeds that level's share of the local threshold, 0 elsewhere.
 // Internal to point_selector.cpp.
 #pragma once

@@ -1,4 +1,4 @@
-// Kernel, sparsification and neighbour structures (method.md §2, §5).
+// Kernel, sparsification and neighbour structures (docs/method.md §2, §5).
 #include <gtest/gtest.h>
 
 #include "acvo/cross_kernel.hpp"

@@ -1,4 +1,4 @@
-// The labelled cloud (method.md §1): HSV from the real channel order, gradient labels,
+// The labelled cloud (docs/method.md §1): HSV from the real channel order, gradient labels,
 // back-projection, and the cost of building a cloud from a Kinect frame.
 #include <algorithm>
 #include <array>

@@ -1,4 +1,4 @@
-// Properties of the DSO-style selection (method.md §1): determinism, count near the target,
+// Properties of the DSO-style selection (docs/method.md §1): determinism, count near the target,
 // border and depth rules, Canny fallback.
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-// SE(3) exp/log: the properties the solver relies on (method.md §3).
+// SE(3) exp/log: the properties the solver relies on (docs/method.md §3).
 #include <random>
 
 #include <gtest/gtest.h>

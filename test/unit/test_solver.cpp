@@ -1,4 +1,4 @@
-// Solver formulas against independent computations (method.md §3, §4).
+// Solver formulas against independent computations (docs/method.md §3, §4).
 #include <gtest/gtest.h>
 
 #include <iostream>
