@@ -18,8 +18,6 @@
 #include "acvo/tum.hpp"
 #include "tool_support.hpp"
 
-extern char** environ;
-
 namespace {
 
 namespace fs = std::filesystem;
@@ -146,8 +144,7 @@ void writeJson(const Options& o, const acvo::RpeResult& rpe, const acvo::AteResu
 fs::path plotScript() {
   if (const char* env = std::getenv("ACVO_PLOT_SCRIPT")) return env;
   std::error_code ec;
-  const fs::path beside =
-      fs::read_symlink("/proc/self/exe", ec).parent_path() / "plot_trajectories.py";
+  fs::path beside = fs::read_symlink("/proc/self/exe", ec).parent_path() / "plot_trajectories.py";
   if (!ec && fs::exists(beside)) return beside;
   return fs::path(ACVO_SCRIPTS_DIR) / "plot_trajectories.py";
 }
