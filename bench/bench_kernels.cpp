@@ -10,6 +10,7 @@
 // The kernel passes run at the transform align() converges to, at ell in millimetres
 // (ell_min, ell_init, ell_max of the default parameters). Times are wall-clock ("Time"): the
 // work is spread over the arena's threads, which the "CPU" column (main thread) does not see.
+#include <cmath>
 #include <cstdlib>
 #include <iostream>
 #include <memory>
@@ -47,7 +48,7 @@ double ellOf(const benchmark::State& state) {
 void ellArguments(benchmark::internal::Benchmark* b) {
   const acvo::SolverParams p;
   b->ArgName("ell_mm");
-  for (double ell : {p.ell_min, p.ell_init, p.ell_max}) b->Arg(long(ell * 1000.0 + 0.5));
+  for (double ell : {p.ell_min, p.ell_init, p.ell_max}) b->Arg(std::lround(ell * 1000.0));
   b->Unit(benchmark::kMillisecond)->UseRealTime();
 }
 

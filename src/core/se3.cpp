@@ -81,8 +81,11 @@ Vector6d logSE3(const Eigen::Isometry3d& T) {
   }
   const Eigen::Vector3d v =
       T.translation() - 0.5 * (W * T.translation()) + D * (W * (W * T.translation()));
+  // Two assignments, not `xi << w, v`: GCC 12 warns (-Warray-bounds, a false positive) about
+  // the 4-double load Eigen's comma initializer makes from the 3-vector w under AVX.
   Vector6d xi;
-  xi << w, v;
+  xi.head<3>() = w;
+  xi.tail<3>() = v;
   return xi;
 }
 

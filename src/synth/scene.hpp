@@ -111,8 +111,8 @@ class RayCaster {
     Eigen::Vector3d origin;        // the ray origin in the box frame
     Eigen::Vector3d half_size;
   };
-  bool castQuad(int q, const Eigen::Vector3d& direction, double* t_best, Hit* hit) const;
-  bool castBox(int b, const Eigen::Vector3d& direction, double* t_best, Hit* hit) const;
+  bool castQuad(int index, const Eigen::Vector3d& d, double* t_best, Hit* hit) const;
+  bool castBox(int index, const Eigen::Vector3d& direction, double* t_best, Hit* hit) const;
 
   const Scene* scene_;
   Eigen::Vector3d origin_;

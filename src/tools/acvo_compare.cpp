@@ -12,9 +12,11 @@
 #include <fstream>
 #include <functional>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <memory>
-#include <sstream>
+#include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -31,25 +33,16 @@
 
 namespace {
 
-const char* const kUsage = R"(usage: acvo_compare DATASET_DIR... [options]
-
-Runs acvo and OpenCV contrib's RgbdOdometry, ICPOdometry and RgbdICPOdometry over TUM RGB-D
+constexpr const char* kDescription =
+    R"(Runs acvo and OpenCV contrib's RgbdOdometry, ICPOdometry and RgbdICPOdometry over TUM RGB-D
 folders (rgb.txt, depth.txt, associations.txt, groundtruth.txt, camera.yaml) and prints one
 table: RPE over 1 s (translation m/s, rotation deg/s), ATE (m), lost frames, median and 90th
 percentile milliseconds per frame, and the median time as a ratio of RgbdOdometry's.
 Every method sees the same decoded frames; times cover the odometry call only (acvo: cloud
 building and registration; OpenCV: grey conversion, pyramids and registration).
-
-options:
-  --methods LIST       comma-separated subset of acvo,rgbd,icp,rgbd_icp (default: all)
-  --config FILE        acvo parameters (default: the built-in defaults = config/acvo.yaml)
-  --set SEC.KEY=VALUE  override one acvo parameter (repeatable)
-  --label NAME         name of the acvo row (default acvo)
-  --frames N           use the first N frames of each dataset
-  --json FILE          write every figure as JSON
-  --trajectories DIR   write each estimate as DIR/<dataset>-<method>.txt
-  --help               this text
 )";
+
+constexpr const char* kFooter = "Exit status: 0 success, 2 bad arguments or input.";
 
 struct Options {
   std::vector<std::string> datasets, methods{"acvo", "rgbd", "icp", "rgbd_icp"}, sets;
@@ -57,71 +50,36 @@ struct Options {
   long frames = -1;
 };
 
-[[noreturn]] void usageError(const std::string& why) {
-  std::cerr << "acvo_compare: " << why << "\n" << kUsage;
-  std::exit(2);
-}
-
-std::vector<std::string> split(const std::string& text, char sep) {
-  std::vector<std::string> out;
-  std::stringstream in(text);
-  for (std::string item; std::getline(in, item, sep);) {
-    if (!item.empty()) out.push_back(item);
-  }
-  return out;
-}
-
-Options parseOptions(int argc, char** argv) {
-  Options o;
-  for (int k = 1; k < argc; ++k) {
-    const std::string a = argv[k];
-    auto value = [&]() -> std::string {
-      if (k + 1 >= argc) usageError(a + " needs a value");
-      return argv[++k];
-    };
-    if (a == "-h" || a == "--help") {
-      std::cout << kUsage;
-      std::exit(0);
-    } else if (a == "--methods") {
-      o.methods = split(value(), ',');
-      for (const auto& m : o.methods) {
-        if (m != "acvo" && m != "rgbd" && m != "icp" && m != "rgbd_icp") {
-          usageError("unknown method '" + m + "'");
-        }
-      }
-    } else if (a == "--config") {
-      o.config = value();
-    } else if (a == "--set") {
-      o.sets.push_back(value());
-    } else if (a == "--label") {
-      o.label = value();
-    } else if (a == "--frames") {
-      try {
-        o.frames = std::stol(value());
-      } catch (const std::exception&) {
-        usageError("--frames expects an integer");
-      }
-    } else if (a == "--json") {
-      o.json = value();
-    } else if (a == "--trajectories") {
-      o.trajectories = value();
-    } else if (!a.empty() && a[0] == '-') {
-      usageError("unknown option " + a);
-    } else {
-      o.datasets.push_back(a);
-    }
-  }
-  if (o.datasets.empty()) usageError("missing DATASET_DIR");
-  if (o.methods.empty()) usageError("--methods is empty");
-  return o;
-}
-
-acvo::Params acvoParams(const Options& o) {
-  try {
-    return acvo::tools::loadToolParams(o.config, o.sets);
-  } catch (const std::invalid_argument& e) {
-    usageError(e.what());
-  }
+// The command line into `o`; nullopt to go on, else the exit status.
+std::optional<int> parseOptions(CLI::App& app, Options& o, int argc, char** argv) {
+  acvo::tools::setUpCommandLine(app, kFooter);
+  app.add_option("DATASET_DIR", o.datasets, "TUM RGB-D folders")->type_name("")->required();
+  app.add_option("--methods", o.methods, "comma-separated subset of acvo,rgbd,icp,rgbd_icp")
+      ->type_name("LIST")
+      ->delimiter(',')
+      ->allow_extra_args(false)
+      ->default_str("all")
+      ->check(CLI::IsMember({"acvo", "rgbd", "icp", "rgbd_icp"}).description(""));
+  app.add_option("--config", o.config, "acvo parameters (default: built in, as config/acvo.yaml)")
+      ->type_name("FILE");
+  app.add_option("--set", o.sets, "override one acvo parameter (repeatable)")
+      ->type_name("SECTION.KEY=VALUE")
+      ->allow_extra_args(false);
+  app.add_option("--label", o.label, "name of the acvo row")
+      ->type_name("NAME")
+      ->capture_default_str();
+  app.add_option("--frames", o.frames, "use the first N frames of each dataset")
+      ->type_name("N")
+      ->check(
+          acvo::tools::numberIn(0L, std::numeric_limits<long>::max(), "a non-negative integer"));
+  app.add_option("--json", o.json, "write every figure as JSON")->type_name("FILE");
+  app.add_option("--trajectories", o.trajectories,
+                 "write each estimate as DIR/<dataset>-<method>.txt")
+      ->type_name("DIR");
+  if (const auto status = acvo::tools::parseCommandLine(app, argc, argv)) return status;
+  // --methods "" or ",": CLI11 leaves the list empty.
+  if (o.methods.empty()) return acvo::tools::usageError(app, "--methods is empty");
+  return std::nullopt;
 }
 
 // One method's run over one dataset.
@@ -218,9 +176,16 @@ std::string jsonNumber(double v) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const Options opt = parseOptions(argc, argv);
+  CLI::App app{kDescription, "acvo_compare"};
+  Options opt;
+  if (const auto status = parseOptions(app, opt, argc, argv)) return *status;
   try {
-    const acvo::Params params = acvoParams(opt);
+    acvo::Params params;
+    try {
+      params = acvo::tools::loadToolParams(opt.config, opt.sets);
+    } catch (const std::exception& e) {  // a malformed --set, an unknown key, a bad config
+      return acvo::tools::usageError(app, e.what());
+    }
     std::vector<Run> runs;
     for (const auto& folder : opt.datasets) {
       const acvo::TumDataset data(folder);

@@ -16,8 +16,7 @@
 
 #include "acvo/evaluation.hpp"
 #include "acvo/tum.hpp"
-
-extern char** environ;
+#include "tool_support.hpp"
 
 namespace {
 
@@ -26,25 +25,16 @@ namespace fs = std::filesystem;
 constexpr int kError = 2;
 constexpr int kPlotFailed = 3;
 
-const char* const kUsage = R"(usage: acvo_eval --groundtruth GT --estimate EST [options]
-
-Relative pose error (as evaluate_rpe.py --fixed_delta) and absolute trajectory error (as
+constexpr const char* kDescription =
+    R"(Relative pose error (as evaluate_rpe.py --fixed_delta) and absolute trajectory error (as
 evaluate_ate.py) of EST against GT, both TUM trajectories "stamp tx ty tz qx qy qz qw".
+)";
 
-options:
-  --delta D            RPE delta (default 1)
-  --delta-unit U       s (seconds, default), f (frames), m (metres travelled),
-                       rad or deg (rotation accumulated)
-  --max-difference S   ATE stamp association limit in seconds (default 0.02)
-  --json FILE          write every figure as JSON
-  --plot FILE.png      plot the ATE-aligned estimate against ground truth (x-y plane and
-                       x/y/z over time); needs /usr/bin/python3 with matplotlib
-  --help               this text
-
+constexpr const char* kFooter =
+    R"(--plot draws the x-y plane and x/y/z over time; it needs /usr/bin/python3 with matplotlib.
 The last line printed is a summary:
   rpe_trans_rmse=<m> rpe_rot_rmse_deg=<deg> ate_rmse=<m> pairs=<rpe pairs>
-Exit status: 0 success, 2 bad arguments or input, 3 the plot could not be made.
-)";
+Exit status: 0 success, 2 bad arguments or input, 3 the plot could not be made.)";
 
 struct Options {
   std::string groundtruth, estimate, json, plot;
@@ -53,49 +43,41 @@ struct Options {
   double max_difference = 0.02;
 };
 
-double parseDouble(const std::string& option, const std::string& text) {
-  std::size_t used = 0;
-  double value = 0.0;
-  try {
-    value = std::stod(text, &used);
-  } catch (const std::exception&) {
-  }
-  if (used == 0 || used != text.size()) {
-    throw std::invalid_argument(option + " expects a number, got '" + text + "'");
-  }
-  return value;
-}
-
-// Returns nullopt when --help was asked for.
-std::optional<Options> parseOptions(int argc, char** argv) {
-  Options o;
-  for (int k = 1; k < argc; ++k) {
-    const std::string arg = argv[k];
-    if (arg == "--help" || arg == "-h") return std::nullopt;
-    if (k + 1 >= argc) throw std::invalid_argument("unknown option or missing value: " + arg);
-    const std::string value = argv[++k];
-    if (arg == "--groundtruth") {
-      o.groundtruth = value;
-    } else if (arg == "--estimate") {
-      o.estimate = value;
-    } else if (arg == "--delta") {
-      o.delta = parseDouble(arg, value);
-    } else if (arg == "--delta-unit") {
-      o.unit = acvo::deltaUnitFromString(value);
-    } else if (arg == "--max-difference") {
-      o.max_difference = parseDouble(arg, value);
-    } else if (arg == "--json") {
-      o.json = value;
-    } else if (arg == "--plot") {
-      o.plot = value;
-    } else {
-      throw std::invalid_argument("unknown option " + arg);
-    }
-  }
-  if (o.groundtruth.empty() || o.estimate.empty()) {
-    throw std::invalid_argument("--groundtruth and --estimate are required");
-  }
-  return o;
+// The command line into `o`; nullopt to go on, else the exit status.
+std::optional<int> parseOptions(CLI::App& app, Options& o, int argc, char** argv) {
+  acvo::tools::setUpCommandLine(app, kFooter);
+  app.add_option("--groundtruth", o.groundtruth, "the ground truth")->type_name("GT")->required();
+  app.add_option("--estimate", o.estimate, "the estimated trajectory")
+      ->type_name("EST")
+      ->required();
+  app.add_option("--delta", o.delta, "RPE delta")
+      ->type_name("D")
+      ->capture_default_str()
+      ->transform(acvo::tools::anyNumber<double>());
+  app.add_option_function<std::string>(
+         "--delta-unit",
+         [&o](const std::string& unit) { o.unit = acvo::deltaUnitFromString(unit); },
+         "seconds, frames, metres travelled, rotation accumulated")
+      ->type_name("s|f|m|rad|deg")
+      ->default_str(acvo::toString(o.unit))
+      ->check(CLI::Validator(
+          [](std::string& unit) -> std::string {
+            try {
+              acvo::deltaUnitFromString(unit);  // the units are the library's to name
+            } catch (const std::invalid_argument& e) {
+              return e.what();
+            }
+            return "";
+          },
+          ""));
+  app.add_option("--max-difference", o.max_difference, "ATE stamp association limit in seconds")
+      ->type_name("S")
+      ->capture_default_str()
+      ->transform(acvo::tools::anyNumber<double>());
+  app.add_option("--json", o.json, "write every figure as JSON")->type_name("FILE");
+  app.add_option("--plot", o.plot, "plot the ATE-aligned estimate against ground truth")
+      ->type_name("FILE.png");
+  return acvo::tools::parseCommandLine(app, argc, argv);
 }
 
 acvo::Trajectory readTrajectoryFile(const std::string& path) {
@@ -162,8 +144,7 @@ void writeJson(const Options& o, const acvo::RpeResult& rpe, const acvo::AteResu
 fs::path plotScript() {
   if (const char* env = std::getenv("ACVO_PLOT_SCRIPT")) return env;
   std::error_code ec;
-  const fs::path beside =
-      fs::read_symlink("/proc/self/exe", ec).parent_path() / "plot_trajectories.py";
+  fs::path beside = fs::read_symlink("/proc/self/exe", ec).parent_path() / "plot_trajectories.py";
   if (!ec && fs::exists(beside)) return beside;
   return fs::path(ACVO_SCRIPTS_DIR) / "plot_trajectories.py";
 }
@@ -217,18 +198,9 @@ bool plot(const Options& o, const acvo::Trajectory& estimate, const acvo::RpeRes
 }  // namespace
 
 int main(int argc, char** argv) {
+  CLI::App app{kDescription, "acvo_eval"};
   Options o;
-  try {
-    const auto parsed = parseOptions(argc, argv);
-    if (!parsed) {
-      std::cout << kUsage;
-      return 0;
-    }
-    o = *parsed;
-  } catch (const std::exception& e) {
-    std::cerr << "acvo_eval: " << e.what() << "\n\n" << kUsage;
-    return kError;
-  }
+  if (const auto status = parseOptions(app, o, argc, argv)) return *status;
 
   acvo::Trajectory groundtruth, estimate;
   acvo::RpeResult rpe;

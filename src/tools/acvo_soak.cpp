@@ -2,14 +2,13 @@
 // faults, reporting memory growth, time per frame and tracking figures. Too long for CI: run it
 // by hand (scripts/soak) after changes to the odometry pipeline.
 #include <algorithm>
-#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
 #include <limits>
-#include <stdexcept>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,75 +18,54 @@
 
 namespace {
 
-constexpr const char* kUsage = R"(usage: acvo_soak [options]
-
-Streams synthetic RGB-D frames (the textured room, random handheld motion at 30 Hz, Kinect
+constexpr const char* kDescription =
+    R"(Streams synthetic RGB-D frames (the textured room, random handheld motion at 30 Hz, Kinect
 noise) through acvo::Odometry and prints, every 1000 frames, the resident memory (VmRSS);
 at the end: frames processed, tracking counts, RSS growth per 1000 frames after a warm-up of
 1000 frames, median / p90 time per frame of Odometry::process, and the largest pose translation.
 After the first --fault-every frames, every period of --fault-every frames carries five faults,
 evenly spaced: a blank frame (black, no depth), a frame with all-zero depth, a frame with all-NaN
-depth, a 1 s blackout of blank frames, a stamp going backwards. Exit status 1 when a pose is not
-finite or processing throws.
-
-options (default in brackets):
-  --frames N           frames to process [10000]
-  --fault-every N      period of the five injected faults in frames, 0 = none [500]
-  --width W --height H image size (intrinsics scaled from 640x480) [640 480]
-  --seed N             scene, motion and noise seed [1]
-  -h, --help           this text
+depth, a 1 s blackout of blank frames, a stamp going backwards.
 )";
 
-struct UsageError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
+constexpr const char* kFooter =
+    "Exit status: 0 success, 1 a pose was not finite or processing threw, 2 bad arguments.";
 
 struct Arguments {
   int frames = 10000;
   int fault_every = 500;
   int width = 640, height = 480;
   unsigned seed = 1;
-  bool help = false;
 };
 
-template <typename T>
-T parseNumber(const std::string& option, const std::string& text) {
-  T value{};
-  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
-  if (text.empty() || error != std::errc() || end != text.data() + text.size()) {
-    throw UsageError(option + " expects a number, got '" + text + "'");
-  }
-  return value;
-}
-
-Arguments parseArguments(int argc, char** argv) {
-  Arguments a;
-  for (int k = 1; k < argc; ++k) {
-    const std::string option = argv[k];
-    if (option == "-h" || option == "--help") {
-      a.help = true;
-      continue;
-    }
-    if (k + 1 >= argc) throw UsageError("unknown option or missing value: " + option);
-    const std::string value = argv[++k];
-    if (option == "--frames") {
-      a.frames = parseNumber<int>(option, value);
-    } else if (option == "--fault-every") {
-      a.fault_every = parseNumber<int>(option, value);
-    } else if (option == "--width") {
-      a.width = parseNumber<int>(option, value);
-    } else if (option == "--height") {
-      a.height = parseNumber<int>(option, value);
-    } else if (option == "--seed") {
-      a.seed = parseNumber<unsigned>(option, value);
-    } else {
-      throw UsageError("unknown option " + option);
-    }
-  }
-  if (a.frames < 1) throw UsageError("--frames must be at least 1");
-  if (a.fault_every < 0) throw UsageError("--fault-every must not be negative");
-  if (a.width < 16 || a.height < 16) throw UsageError("--width and --height must be at least 16");
-  return a;
+// The command line into `a`; nullopt to go on, else the exit status.
+std::optional<int> parseArguments(CLI::App& app, Arguments& a, int argc, char** argv) {
+  using acvo::tools::numberIn;
+  const int kIntMax = std::numeric_limits<int>::max();
+  acvo::tools::setUpCommandLine(app, kFooter);
+  app.add_option("--frames", a.frames, "frames to process")
+      ->type_name("N")
+      ->capture_default_str()
+      ->transform(numberIn(1, kIntMax, "at least 1"));
+  app.add_option("--fault-every", a.fault_every,
+                 "period of the five injected faults in frames, 0 = none")
+      ->type_name("N")
+      ->capture_default_str()
+      ->transform(numberIn(0, kIntMax, "a non-negative integer"));
+  const auto size = numberIn(16, kIntMax, "at least 16 pixels");
+  app.add_option("--width", a.width, "image size (intrinsics scaled from 640x480)")
+      ->type_name("W")
+      ->capture_default_str()
+      ->transform(size);
+  app.add_option("--height", a.height, "image height")
+      ->type_name("H")
+      ->capture_default_str()
+      ->transform(size);
+  app.add_option("--seed", a.seed, "scene, motion and noise seed")
+      ->type_name("N")
+      ->capture_default_str()
+      ->transform(acvo::tools::anyNumber<unsigned>());
+  return acvo::tools::parseCommandLine(app, argc, argv);
 }
 
 enum class Fault { kNone, kBlank, kZeroDepth, kNanDepth, kBlackout, kStampBack };
@@ -245,16 +223,11 @@ int run(const Arguments& args) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  CLI::App app{kDescription, "acvo_soak"};
+  Arguments args;
+  if (const auto status = parseArguments(app, args, argc, argv)) return *status;
   try {
-    const Arguments args = parseArguments(argc, argv);
-    if (args.help) {
-      std::cout << kUsage;
-      return 0;
-    }
     return run(args);
-  } catch (const UsageError& e) {
-    std::cerr << "acvo_soak: " << e.what() << "\n\n" << kUsage;
-    return 2;
   } catch (const std::exception& e) {
     std::cerr << "acvo_soak: " << e.what() << "\n";
     return 1;

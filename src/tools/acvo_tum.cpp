@@ -7,6 +7,9 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <limits>
+#include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -17,16 +20,17 @@
 
 namespace {
 
-const char* kUsage =
-    "usage: acvo_tum DATASET_DIR [--config FILE] [--camera FILE|fr1|fr2|fr3|default]\n"
-    "                [--output TRAJ] [--stats CSV] [--start N] [--frames N] [--threads N]\n"
-    "                [--set SECTION.KEY=VALUE ...]\n"
-    "Runs A-CVO frame-to-frame odometry over a TUM RGB-D folder (rgb.txt, depth.txt,\n"
-    "optional associations.txt, groundtruth.txt, camera.yaml) and writes the trajectory in\n"
-    "TUM format (default DATASET_DIR/acvo_trajectory.txt). The first pose is the ground-truth\n"
-    "pose of the first frame when groundtruth.txt exists, identity otherwise.\n"
+constexpr const char* kDescription =
+    R"(Runs A-CVO frame-to-frame odometry over a TUM RGB-D folder (rgb.txt, depth.txt,
+optional associations.txt, groundtruth.txt, camera.yaml) and writes the trajectory in
+TUM format (default DATASET_DIR/acvo_trajectory.txt). The first pose is the ground-truth
+pose of the first frame when groundtruth.txt exists, identity otherwise.
+)";
+
+constexpr const char* kFooter =
     "--set overrides one parameter of the config, e.g. --set solver.ell_policy=fixed_schedule.\n"
-    "Last line: frames=N median_ms=X p90_ms=Y failures=Z (cloud + registration per frame).\n";
+    "Last line: frames=N median_ms=X p90_ms=Y failures=Z (cloud + registration per frame).\n"
+    "Exit status: 0 success, 2 bad arguments or input.";
 
 struct Options {
   std::string dataset, config, camera, output, stats;
@@ -35,85 +39,60 @@ struct Options {
   int threads = -1;
 };
 
-[[noreturn]] void usageError(const std::string& why) {
-  std::cerr << "acvo_tum: " << why << "\n" << kUsage;
-  std::exit(2);
-}
-
-long parseLong(const std::string& flag, const std::string& value) {
-  try {
-    std::size_t used = 0;
-    const long v = std::stol(value, &used);
-    if (used == value.size() && v >= 0) return v;
-  } catch (const std::exception&) {
-  }
-  usageError(flag + " expects a non-negative integer, got '" + value + "'");
-}
-
-Options parseOptions(int argc, char** argv) {
-  Options o;
-  for (int k = 1; k < argc; ++k) {
-    const std::string a = argv[k];
-    auto value = [&]() -> std::string {
-      if (k + 1 >= argc) usageError(a + " needs a value");
-      return argv[++k];
-    };
-    if (a == "-h" || a == "--help") {
-      std::cout << kUsage;
-      std::exit(0);
-    } else if (a == "--config") {
-      o.config = value();
-    } else if (a == "--camera") {
-      o.camera = value();
-    } else if (a == "--output") {
-      o.output = value();
-    } else if (a == "--stats") {
-      o.stats = value();
-    } else if (a == "--start") {
-      o.start = parseLong(a, value());
-    } else if (a == "--frames") {
-      o.frames = parseLong(a, value());
-    } else if (a == "--threads") {
-      o.threads = int(parseLong(a, value()));
-    } else if (a == "--set") {
-      o.sets.push_back(value());
-    } else if (!a.empty() && a[0] == '-') {
-      usageError("unknown option " + a);
-    } else if (o.dataset.empty()) {
-      o.dataset = a;
-    } else {
-      usageError("unexpected argument " + a);
-    }
-  }
-  if (o.dataset.empty()) usageError("missing DATASET_DIR");
-  return o;
-}
-
-acvo::Params loadParameters(const Options& o) {
-  acvo::Params p;
-  try {
-    p = acvo::tools::loadToolParams(o.config, o.sets);
-  } catch (const std::invalid_argument& e) {
-    usageError(e.what());
-  }
-  if (o.threads >= 0) p.odometry.threads = o.threads;
-  return p;
+// The command line into `o`; nullopt to go on, else the exit status.
+std::optional<int> parseOptions(CLI::App& app, Options& o, int argc, char** argv) {
+  using acvo::tools::numberIn;
+  const long kLongMax = std::numeric_limits<long>::max();
+  acvo::tools::setUpCommandLine(app, kFooter);
+  app.add_option("DATASET_DIR", o.dataset, "the TUM RGB-D folder")->type_name("")->required();
+  app.add_option("--config", o.config, "parameters (YAML; default: the built-in defaults)")
+      ->type_name("FILE");
+  app.add_option("--camera", o.camera,
+                 "intrinsics (default: DATASET_DIR/camera.yaml, else default)")
+      ->type_name("FILE|fr1|fr2|fr3|default");
+  app.add_option("--output", o.output, "the trajectory (default DATASET_DIR/acvo_trajectory.txt)")
+      ->type_name("TRAJ");
+  app.add_option("--stats", o.stats, "per-frame figures as CSV")->type_name("CSV");
+  app.add_option("--start", o.start, "first frame (0-based)")
+      ->type_name("N")
+      ->capture_default_str()
+      ->transform(numberIn(0L, kLongMax, "a non-negative integer"));
+  app.add_option("--frames", o.frames, "number of frames (default: to the end)")
+      ->type_name("N")
+      ->transform(numberIn(0L, kLongMax, "a non-negative integer"));
+  app.add_option("--threads", o.threads, "worker threads (default: the config's)")
+      ->type_name("N")
+      ->transform(numberIn(0, std::numeric_limits<int>::max(), "a non-negative integer"));
+  app.add_option("--set", o.sets, "override one parameter of the config (repeatable)")
+      ->type_name("SECTION.KEY=VALUE")
+      ->allow_extra_args(false);
+  return acvo::tools::parseCommandLine(app, argc, argv);
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  const Options opt = parseOptions(argc, argv);
+  CLI::App app{kDescription, "acvo_tum"};
+  Options opt;
+  if (const auto status = parseOptions(app, opt, argc, argv)) return *status;
   try {
-    const acvo::Params params = loadParameters(opt);
+    acvo::Params params;
+    try {
+      params = acvo::tools::loadToolParams(opt.config, opt.sets);
+    } catch (const std::exception& e) {  // a malformed --set, an unknown key, a bad config
+      return acvo::tools::usageError(app, e.what());
+    }
+    if (opt.threads >= 0) params.odometry.threads = opt.threads;
     const acvo::TumDataset data(opt.dataset, opt.camera);
     const std::string output =
         opt.output.empty() ? opt.dataset + "/acvo_trajectory.txt" : opt.output;
     const long first = std::min<long>(opt.start, long(data.size()));
     const long last =
         opt.frames < 0 ? long(data.size()) : std::min<long>(long(data.size()), first + opt.frames);
-    if (first >= last)
-      usageError("no frames to process (dataset has " + std::to_string(data.size()) + ")");
+    if (first >= last) {
+      return acvo::tools::usageError(
+          app, "no frames to process (dataset has " + std::to_string(data.size()) + ")");
+    }
 
     std::ofstream stats;
     if (!opt.stats.empty()) {

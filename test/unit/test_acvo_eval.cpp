@@ -107,7 +107,7 @@ TEST(AcvoEval, BadInputExitsWithTwo) {
             2);
   const ToolRun help = runTool("--help");
   EXPECT_EQ(help.status, 0);
-  EXPECT_NE(help.output.find("usage: acvo_eval"), std::string::npos);
+  EXPECT_NE(help.output.find("Usage: acvo_eval"), std::string::npos);
 }
 
 TEST(AcvoEval, PlotWritesAPng) {

@@ -1,4 +1,5 @@
 // Depth decoding: every raw encoding gives the same metres; invalid pixels become 0.
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <stdexcept>
@@ -18,8 +19,10 @@ constexpr int kCount = sizeof(kMetres) / sizeof(kMetres[0]);
 TEST(Depth, TumPngMillimetresAndMetresGiveTheSameMetres) {
   cv::Mat tum(2, 3, CV_16UC1), mm(2, 3, CV_16UC1), m(2, 3, CV_32FC1);
   for (int k = 0; k < kCount; ++k) {
-    tum.at<std::uint16_t>(k / 3, k % 3) = static_cast<std::uint16_t>(kMetres[k] * 5000.0 + 0.5);
-    mm.at<std::uint16_t>(k / 3, k % 3) = static_cast<std::uint16_t>(kMetres[k] * 1000.0 + 0.5);
+    tum.at<std::uint16_t>(k / 3, k % 3) =
+        static_cast<std::uint16_t>(std::lround(kMetres[k] * 5000.0));
+    mm.at<std::uint16_t>(k / 3, k % 3) =
+        static_cast<std::uint16_t>(std::lround(kMetres[k] * 1000.0));
     m.at<float>(k / 3, k % 3) = kMetres[k];
   }
   // The TUM encoding goes through a real PNG file, as the datasets store it.

@@ -47,7 +47,9 @@ TEST(NumericFaults, CloudsOfIdenticalPointsGiveAStatusAndAFiniteTransform) {
       const SolverResult r = alignClouds(*fixed, *moving);
       EXPECT_TRUE(r.transform.matrix().allFinite()) << toString(r.status);
       EXPECT_TRUE(std::isfinite(r.inner_product)) << toString(r.status);
-      if (n < SolverParams().min_points) EXPECT_EQ(r.status, SolverStatus::kTooFewPoints);
+      if (n < SolverParams().min_points) {
+        EXPECT_EQ(r.status, SolverStatus::kTooFewPoints);
+      }
     }
   }
 }

@@ -185,7 +185,9 @@ TEST(TumTrajectory, WriteThenReadIsExact) {
   const acvo::Trajectory r = acvo::readTrajectory(path);
   ASSERT_EQ(r.size(), t.size());
   for (std::size_t k = 0; k < t.size(); ++k) {
-    if (!t[k].stamp_text.empty()) EXPECT_EQ(r[k].stamp_text, t[k].stamp_text);
+    if (!t[k].stamp_text.empty()) {
+      EXPECT_EQ(r[k].stamp_text, t[k].stamp_text);
+    }
     EXPECT_EQ(r[k].stamp, t[k].stamp) << k;  // also without a text: written exactly
     EXPECT_LT((r[k].pose.translation() - t[k].pose.translation()).norm(), 1e-12) << k;
     EXPECT_LT((r[k].pose.linear() - t[k].pose.linear()).norm(), 1e-12) << k;
