@@ -414,11 +414,17 @@ TEST(Keyframes, ANewKeyframeIsTakenWhereTheMotionOrTheOverlapCrossesItsThreshold
       const double from_start = (seq.poses()[0].inverse() * seq.poses()[i]).translation().norm();
       if (i > 0 && r.new_keyframe) {
         switched = i;
-        if (criterion == 0) EXPECT_GT(from_start, 0.045 - 1.5e-3);
-        if (criterion == 1) EXPECT_LT(r.solver.matched_fraction, 0.9);
+        if (criterion == 0) {
+          EXPECT_GT(from_start, 0.045 - 1.5e-3);
+        } else {
+          EXPECT_LT(r.solver.matched_fraction, 0.9);
+        }
       } else if (i > 0) {
-        if (criterion == 0) EXPECT_LT(from_start, 0.045 + 1.5e-3) << i;
-        if (criterion == 1) EXPECT_GE(r.solver.matched_fraction, 0.9) << i;
+        if (criterion == 0) {
+          EXPECT_LT(from_start, 0.045 + 1.5e-3) << i;
+        } else {
+          EXPECT_GE(r.solver.matched_fraction, 0.9) << i;
+        }
       }
     }
     std::printf("  criterion %s: the first new keyframe is frame %d\n",
