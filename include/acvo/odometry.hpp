@@ -147,7 +147,8 @@ class Odometry {
   void asReference(OdometryResult& r, PreparedCloud& cloud);
   Registration registerTo(const Tracked& reference, const PreparedCloud& current,
                           const Eigen::Isometry3d& guess);
-  void tracked(OdometryResult& r, Registration reg, const std::shared_ptr<PreparedCloud>& current);
+  void tracked(OdometryResult& r, const Registration& reg,
+               const std::shared_ptr<PreparedCloud>& current);
   void lost(OdometryResult& r, const Registration& reg,
             const std::shared_ptr<PreparedCloud>& current, double stamp);
 

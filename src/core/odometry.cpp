@@ -65,29 +65,29 @@ double rotationDeg(const Eigen::Isometry3d& T) {
 }  // namespace
 
 Judgement judgeTracking(const SolverResult& s, const Eigen::Isometry3d& frame_motion,
-                        const OdometryParams& op) {
+                        const OdometryParams& params) {
   const double rotation_deg = rotationDeg(frame_motion);
   const double translation = frame_motion.translation().norm();
   if (s.status == SolverStatus::kTooFewPoints || s.status == SolverStatus::kNotFinite) {
     return {Tracking::kLost, "registration failed: " + toString(s.status)};
   }
-  if (s.matched_fraction < op.lost_matched_fraction) {
+  if (s.matched_fraction < params.lost_matched_fraction) {
     // Next to no point found a partner: the solver had nothing to hold on to (a frame of noise,
     // a view with nothing in common). A low overlap alone is not this: a fast motion that
     // keeps a fifth of the view in common is registered from that fifth and kept.
     return {Tracking::kLost, "clouds do not overlap (" + percent(s.matched_fraction) +
                                  " of the points found a partner)"};
   }
-  if (translation > op.max_translation || rotation_deg > op.max_rotation) {
+  if (translation > params.max_translation || rotation_deg > params.max_rotation) {
     return {Tracking::kLost, "implausible motion (" + std::to_string(translation) + " m, " +
                                  std::to_string(rotation_deg) + " deg in one frame)"};
   }
-  if (s.matched_fraction < op.hard_matched_fraction) {
+  if (s.matched_fraction < params.hard_matched_fraction) {
     return {Tracking::kHard,
             "weak overlap (" + percent(s.matched_fraction) + " of the points found a partner)"};
   }
   if (s.status == SolverStatus::kMaxIterations) return {Tracking::kHard, "iteration cap reached"};
-  if (s.ell_max_reductions >= op.hard_ell_reductions) {
+  if (s.ell_max_reductions >= params.hard_ell_reductions) {
     return {Tracking::kHard, "length-scale kept reaching its upper bound (" +
                                  std::to_string(s.ell_max_reductions) +
                                  " reductions): weak structure"};
@@ -222,7 +222,7 @@ OdometryResult Odometry::process(const Frame& frame,
   if (reg.judgement.tracking == Tracking::kLost) {
     lost(r, reg, current, frame.stamp);
   } else {
-    tracked(r, std::move(reg), current);
+    tracked(r, reg, current);
   }
   return r;
 }
@@ -291,7 +291,7 @@ Odometry::Registration Odometry::registerFrame(OdometryResult& r, const Prepared
   return reg;
 }
 
-void Odometry::tracked(OdometryResult& r, Registration reg,
+void Odometry::tracked(OdometryResult& r, const Registration& reg,
                        const std::shared_ptr<PreparedCloud>& current) {
   const Tracked& keyframe = *keyframe_;
   const Eigen::Isometry3d& to_keyframe = reg.solver.transform;

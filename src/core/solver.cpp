@@ -311,9 +311,9 @@ bool StallTracker::stalls(double ell, double F, const Eigen::Isometry3d& T) {
 Vector6d SearchState::next(const Vector6d& g, SearchDirection kind) {
   const bool first = !started_;
   started_ = true;
-  const Vector6d d = kind == SearchDirection::kConjugateGradient && !first
-                         ? conjugateDirection(g, g_prev_, d_prev_)
-                         : g;
+  Vector6d d = kind == SearchDirection::kConjugateGradient && !first
+                   ? conjugateDirection(g, g_prev_, d_prev_)
+                   : g;
   g_prev_ = g;
   d_prev_ = d;
   return d;
