@@ -521,15 +521,17 @@ TEST(OdometryNodelet, InvalidFramesAreLostThenTrackingResumes) {
       {client->blank(), "no valid depth"},
       {client->farDepth(4), "no valid depth"},
       {client->flatColour(4), "no intensity gradient"}};
+  // One frame in flight at a time (run()): the subscriber queues are short by design.
+  std::vector<RgbdImage> images;
   std::vector<ros::Time> stamps;
   for (const auto& frame : invalid) {
+    images.push_back(frame.first);
     stamps.push_back(client->nextStamp());
-    client->send(frame.first, stamps.back());
   }
-  client->flush();
+  const std::vector<Outcome> outcomes = client->run(images, stamps);
   for (std::size_t i = 0; i < invalid.size(); ++i) {
     SCOPED_TRACE(invalid[i].second);
-    const Outcome o = client->outcome(stamps[i], true);
+    const Outcome& o = outcomes[i];
     ASSERT_TRUE(o.info);
     EXPECT_TRUE(o.info->lost) << o.info->tracking << ": " << o.info->message;
     EXPECT_EQ(o.info->tracking, "lost");
@@ -593,10 +595,9 @@ TEST(OdometryNodelet, EveryOtherFrameMissingIsTrackedAndEveryFrameIsPublished) {
   for (std::size_t i = 0; i < out.size(); ++i) {
     SCOPED_TRACE("frame " + std::to_string(2 * i));
     ASSERT_TRUE(out[i].info) << "no odom_info";
-    ASSERT_TRUE(out[i].odom) << "no odom (" << out[i].info->tracking << ": "
-                             << out[i].info->message << ")";
-    EXPECT_TRUE(i == 0 ? out[i].info->tracking == "first_frame"
-                       : isTracking(out[i].info->tracking))
+    ASSERT_TRUE(out[i].odom) << "no odom (" << out[i].info->tracking << ": " << out[i].info->message
+                             << ")";
+    EXPECT_TRUE(i == 0 ? out[i].info->tracking == "first_frame" : isTracking(out[i].info->tracking))
         << out[i].info->tracking << ": " << out[i].info->message;
   }
   // The budget is per frame of motion (12 frames' worth in 6 registrations).
@@ -613,7 +614,7 @@ TEST(OdometryNodelet, BlackoutOfBlankFramesIsLostNamedThenTrackingResumes) {
   std::vector<ros::Time> stamps;
   for (int k = 0; k < kBefore + kBlank + kAfter; ++k) {
     const bool blank = k >= kBefore && k < kBefore + kBlank;
-    images.push_back(!blank ? client->frame(k)
+    images.push_back(!blank                     ? client->frame(k)
                      : k < kBefore + kBlank / 2 ? client->blank()
                                                 : client->flatColour(k));
     stamps.push_back(client->nextStamp());
@@ -671,8 +672,8 @@ TEST(OdometryNodelet, BlackoutOfBlankFramesIsLostNamedThenTrackingResumes) {
   const Eigen::Isometry3d truth = expectedMotion(kBefore - 1, last);
   const Eigen::Isometry3d unseen = expectedMotion(kBefore - 1, resumed);
   const double across_t = (across.translation() - truth.translation()).norm();
-  std::cout << "[ MEASURED ] blackout: error from frame " << kBefore - 1 << " to " << last
-            << ": " << across_t << " m (motion from the last good frame to resumption "
+  std::cout << "[ MEASURED ] blackout: error from frame " << kBefore - 1 << " to " << last << ": "
+            << across_t << " m (motion from the last good frame to resumption "
             << unseen.translation().norm() << " m)\n";
   EXPECT_LT(across_t, unseen.translation().norm() + (last - resumed) * kTranslationPerFrame);
 }
@@ -690,8 +691,8 @@ TEST(OdometryNodelet, ASingleFrameOfNoiseIsLostAndTrackingResumes) {
   EXPECT_TRUE(out[3].info->lost) << out[3].info->tracking << ": " << out[3].info->message;
   EXPECT_FALSE(out[3].info->message.empty());
   for (std::size_t k = 4; k < out.size(); ++k) {
-    std::cout << "[ MEASURED ] after the noise frame, frame " << k << ": "
-              << out[k].info->tracking << " " << out[k].info->message << "\n";
+    std::cout << "[ MEASURED ] after the noise frame, frame " << k << ": " << out[k].info->tracking
+              << " " << out[k].info->message << "\n";
   }
   EXPECT_TRUE(isTracking(out[5].info->tracking)) << out[5].info->message;
   EXPECT_TRUE(isTracking(out[6].info->tracking)) << out[6].info->message;
@@ -878,25 +879,52 @@ TEST(OdometryNodelet, ReconfigureRestartsTrackingWithNewParametersAndRefusesBadO
   reconfigure("target_points", 1500, true);
 }
 
-TEST(OdometryNodelet, LostFramesPublishNothingWhenAskedTo) {
+bool setLostOdom(const std::string& value) {
+  dynamic_reconfigure::Reconfigure srv;
+  dynamic_reconfigure::StrParameter p;
+  p.name = "lost_odom";
+  p.value = value;
+  srv.request.config.strs.push_back(p);
+  return ros::service::call("acvo/set_parameters", srv);
+}
+
+// lost_odom: none publishes nothing for a lost frame; null publishes rtabmap's null message (a
+// zero pose, all-zero quaternion, 1e6 variances: publish_null_when_lost there), and no TF.
+TEST(OdometryNodelet, LostFramesPublishNothingOrANullMessageWhenAskedTo) {
   if (client->late_base_tf_) GTEST_SKIP() << "covered by the other configurations";
   ASSERT_TRUE(client->reset());
-  client->run(range(0, 3));
-  dynamic_reconfigure::Reconfigure srv;
-  dynamic_reconfigure::BoolParameter p;
-  p.name = "publish_null_when_lost";
-  p.value = true;
-  srv.request.config.bools.push_back(p);
-  ASSERT_TRUE(ros::service::call("acvo/set_parameters", srv));
+  std::vector<ros::Time> stamps;
+  const std::vector<Outcome> good = client->run(range(0, 3), &stamps);
+  ASSERT_TRUE(good.back().odom);
+
+  ASSERT_TRUE(setLostOdom("none"));
   const ros::Time t = client->nextStamp();
   client->send(client->blank(), t);
   client->flush();
   const Outcome o = client->outcome(t, false);
   ASSERT_TRUE(o.info);
   EXPECT_TRUE(o.info->lost);
-  EXPECT_FALSE(o.odom) << "publish_null_when_lost: nothing is published for a lost frame";
-  srv.request.config.bools[0].value = false;
-  ASSERT_TRUE(ros::service::call("acvo/set_parameters", srv));
+  EXPECT_FALSE(o.odom) << "lost_odom none: nothing is published for a lost frame";
+  EXPECT_FALSE(client->lookup(t)) << "lost_odom none: no TF for a lost frame";
+
+  ASSERT_TRUE(setLostOdom("null"));
+  const ros::Time n = client->nextStamp();
+  client->send(client->blank(), n);
+  client->flush();
+  const Outcome null = client->outcome(n, true);
+  ASSERT_TRUE(null.info);
+  EXPECT_TRUE(null.info->lost);
+  ASSERT_TRUE(null.odom) << "lost_odom null: a null message is published for a lost frame";
+  const auto& q = null.odom->pose.pose.orientation;
+  EXPECT_EQ(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w, 0.0) << "a null pose";
+  EXPECT_EQ(null.odom->pose.pose.position.x, 0.0);
+  EXPECT_EQ(null.odom->child_frame_id, client->base_frame_);
+  for (int d = 0; d < 6; ++d) {
+    EXPECT_EQ(null.odom->pose.covariance[7 * d], acvo_ros::kLostVariance);
+    EXPECT_EQ(null.odom->twist.covariance[7 * d], acvo_ros::kLostVariance);
+  }
+  EXPECT_FALSE(client->lookup(n)) << "lost_odom null: no TF for a lost frame";
+  ASSERT_TRUE(setLostOdom("held"));
 }
 
 TEST(OdometryNodelet, MissingBaseTransformIsReportedNotReplacedByIdentity) {
