@@ -7,7 +7,7 @@
 // .test publishes; empty = base is the optical frame), exact_stamps (run the stamp tests, which
 // need exact synchronisation: the approximate policy itself swallows reordered stamps),
 // late_base_tf (the .test publishes no base transform; the test sends it itself, after checking
-// that nothing is published without it).
+// that nothing is published without it), initial_pose (the nodelet's, when the .test sets one).
 #include <cmath>
 #include <map>
 #include <mutex>
@@ -31,6 +31,7 @@
 #include "acvo/params.hpp"
 #include "conversions.hpp"
 #include "covariance.hpp"
+#include "nodelet_settings.hpp"
 #include "synthetic_room.hpp"
 #include "test_messages.hpp"
 
@@ -91,6 +92,7 @@ class Client {
     base_frame_ = pnh_.param<std::string>("base_frame", acvo_ros::stripSlash(camera_frame_));
     exact_stamps_ = pnh_.param("exact_stamps", false);
     late_base_tf_ = pnh_.param("late_base_tf", false);
+    initial_pose_ = acvo_ros::parsePose6(pnh_.param<std::string>("initial_pose", ""), nullptr);
     base_from_camera_ = Eigen::Isometry3d::Identity();
     std::istringstream tf(pnh_.param<std::string>("base_from_camera", ""));
     double x, y, z, qx, qy, qz, qw;
@@ -308,6 +310,8 @@ class Client {
   std::string depth_encoding_, color_encoding_, camera_frame_, odom_frame_, base_frame_;
   bool approx_ = true, exact_stamps_ = false;
   bool late_base_tf_ = false;  // the .test publishes no base transform: the test sends it
+  // The nodelet's initial_pose, when the .test sets one ("x y z roll pitch yaw").
+  std::optional<Eigen::Isometry3d> initial_pose_;
   Eigen::Isometry3d base_from_camera_;
   ros::Publisher rgb_pub_, depth_pub_, info_pub_;
   ros::Subscriber odom_sub_, info_sub_, diag_sub_, rosout_sub_;
@@ -383,6 +387,47 @@ void expectPoseNear(const geometry_msgs::Pose& got, const Eigen::Isometry3d& wan
   EXPECT_LT(dr, max_r) << what << ": rotation error " << dr << " rad";
   std::cout << "[ MEASURED ] " << what << ": translation error " << dt << " m, rotation error "
             << dr << " rad (" << frames << " frames)\n";
+}
+
+// Runs first (gtest keeps the order of definition): before any frame, the camera frame and its
+// transform to the base are unknown; the pose given is where the first frame starts.
+TEST(OdometryNodelet, AResetToPoseBeforeTheFirstFrameIsWhereItStarts) {
+  if (client->late_base_tf_ || client->initial_pose_) {
+    GTEST_SKIP() << "needs a nodelet that has seen no frame and starts at the origin";
+  }
+  Eigen::Isometry3d given = Eigen::Isometry3d::Identity();
+  given.linear() = Eigen::AngleAxisd(-0.4, Eigen::Vector3d::UnitZ()).matrix();
+  given.translation() << -1.5, 0.25, 0.1;
+  const auto res = client->resetTo(given);
+  ASSERT_TRUE(res);
+  EXPECT_TRUE(res->success) << res->message;
+  std::cout << "[ MEASURED ] reset_odom_to_pose before the first frame: " << res->message << "\n";
+  const std::vector<Outcome> out = client->run(range(0, 4));
+  ASSERT_TRUE(out[0].odom && out.back().odom);
+  EXPECT_EQ(out[0].info->tracking, "first_frame");
+  expectPoseNear(out[0].odom->pose.pose, given, 0, "first frame after an early reset_odom_to_pose");
+  expectPoseNear(out.back().odom->pose.pose, given * client->expectedBase(cameraPose(3)), 3,
+                 "3 frames after an early reset_odom_to_pose");
+}
+
+// initial_pose (nodelet_initial_pose.test): the first frame's pose, and tracking goes on from it.
+TEST(OdometryNodelet, StartsAtTheInitialPose) {
+  if (!client->initial_pose_) GTEST_SKIP() << "needs a .test that sets initial_pose";
+  const std::vector<Outcome> out = client->run(range(0, 4));
+  ASSERT_TRUE(out[0].odom && out.back().odom);
+  EXPECT_EQ(out[0].info->tracking, "first_frame");
+  expectPoseNear(out[0].odom->pose.pose, *client->initial_pose_, 0, "first frame, initial_pose");
+  expectPoseNear(out.back().odom->pose.pose,
+                 *client->initial_pose_ * client->expectedBase(cameraPose(3)), 3,
+                 "3 frames after initial_pose");
+  const auto tf = client->lookup(out.back().odom->header.stamp);
+  ASSERT_TRUE(tf);
+  EXPECT_TRUE(tf2::transformToEigen(*tf).isApprox(toEigen(out.back().odom->pose.pose), 1e-6));
+  // reset_odom goes back to the origin, not to initial_pose (as rtabmap's).
+  ASSERT_TRUE(client->reset());
+  const std::vector<Outcome> again = client->run(range(4, 6));
+  ASSERT_TRUE(again[0].odom);
+  expectPoseNear(again[0].odom->pose.pose, Eigen::Isometry3d::Identity(), 0, "after reset_odom");
 }
 
 TEST(OdometryNodelet, TracksKnownMotionWithRightFramesCovarianceAndTf) {
@@ -925,6 +970,46 @@ TEST(OdometryNodelet, LostFramesPublishNothingOrANullMessageWhenAskedTo) {
   }
   EXPECT_FALSE(client->lookup(n)) << "lost_odom null: no TF for a lost frame";
   ASSERT_TRUE(setLostOdom("held"));
+}
+
+bool callEmpty(const std::string& service) {
+  std_srvs::Empty srv;
+  return ros::service::call(service, srv);
+}
+
+// pause_odom: frames are dropped (no odom, no odom_info), diagnostics say "paused";
+// resume_odom: the next frame is registered to the last tracked one and tracking goes on.
+TEST(OdometryNodelet, PauseDropsFramesAndResumeGoesOn) {
+  if (client->late_base_tf_) GTEST_SKIP() << "covered by the other configurations";
+  ASSERT_TRUE(client->reset());
+  const std::vector<Outcome> before = client->run(range(0, 4));
+  ASSERT_TRUE(before.back().odom);
+  ASSERT_TRUE(callEmpty("pause_odom"));
+  std::vector<ros::Time> paused;
+  for (int k = 4; k < 6; ++k) {
+    paused.push_back(client->nextStamp());
+    client->send(client->frame(k), paused.back());
+  }
+  client->flush();
+  for (const ros::Time& t : paused) {
+    const Outcome o = client->outcome(t, false, 1.0);
+    EXPECT_FALSE(o.info) << "a frame was processed while paused";
+    EXPECT_FALSE(o.odom) << "a frame was published while paused";
+  }
+  const auto diag = client->waitDiagnostic(diagnostic_msgs::DiagnosticStatus::WARN, "paused");
+  ASSERT_TRUE(diag);
+  EXPECT_EQ(diag->message, "paused");
+  ASSERT_TRUE(callEmpty("resume_odom"));
+  const std::vector<Outcome> after = client->run(range(6, 9));
+  for (const Outcome& o : after) {
+    ASSERT_TRUE(o.info && o.odom);
+    EXPECT_TRUE(isTracking(o.info->tracking)) << o.info->tracking << ": " << o.info->message;
+  }
+  // The first frame sent while paused never comes out (the last one may: the approximate
+  // synchroniser holds it until the next frame, sent after resume_odom).
+  EXPECT_EQ(client->infoCount(paused.front()), 0);
+  expectPoseNear(after.back().odom->pose.pose, client->expectedBase(cameraPose(8)), 8,
+                 "3 frames after a pause of 2 frames");
 }
 
 TEST(OdometryNodelet, MissingBaseTransformIsReportedNotReplacedByIdentity) {
