@@ -7,7 +7,8 @@
 // .test publishes; empty = base is the optical frame), exact_stamps (run the stamp tests, which
 // need exact synchronisation: the approximate policy itself swallows reordered stamps),
 // late_base_tf (the .test publishes no base transform; the test sends it itself, after checking
-// that nothing is published without it), initial_pose (the nodelet's, when the .test sets one).
+// that nothing is published without it), burst (run the burst test, whose stamps are the wall
+// clock's, on a fresh nodelet), initial_pose (the nodelet's, when the .test sets one).
 #include <cmath>
 #include <map>
 #include <mutex>
@@ -50,6 +51,11 @@ constexpr double kTranslationPerFrame = 0.004;  // m
 constexpr double kRotationPerFrame = 0.003;     // rad
 constexpr double kExact = 1e-9;
 constexpr double kOutcomeTimeout = 20.0;  // s, one frame through a loaded machine
+// Latency beyond the frames' processing: transport and scheduling on a loaded machine (ms).
+constexpr double kLatencySlack = 100.0;
+// Frames a new one may wait for with topic_queue_size 2: the one in progress, two queued and
+// one in the synchroniser, plus its own processing.
+constexpr double kQueuedFrames = 5.0;
 
 double angleOf(const Eigen::Matrix3d& r) {
   return Eigen::AngleAxisd(r).angle();
@@ -92,6 +98,7 @@ class Client {
     base_frame_ = pnh_.param<std::string>("base_frame", acvo_ros::stripSlash(camera_frame_));
     exact_stamps_ = pnh_.param("exact_stamps", false);
     late_base_tf_ = pnh_.param("late_base_tf", false);
+    burst_ = pnh_.param("burst", false);
     initial_pose_ = acvo_ros::parsePose6(pnh_.param<std::string>("initial_pose", ""), nullptr);
     base_from_camera_ = Eigen::Isometry3d::Identity();
     std::istringstream tf(pnh_.param<std::string>("base_from_camera", ""));
@@ -132,6 +139,27 @@ class Client {
   }
   // A pause in the stream: the next stamp comes `seconds` later than it would have.
   void skipTime(double seconds) { next_stamp_ += ros::Duration(seconds); }
+
+  // The three messages of a frame, built ahead of publishing (a burst is then quick).
+  struct Messages {
+    sensor_msgs::ImagePtr rgb, depth;
+    sensor_msgs::CameraInfoPtr info;
+  };
+  Messages messages(const RgbdImage& img, const ros::Time& stamp) {
+    std_msgs::Header h;
+    h.stamp = stamp;
+    h.frame_id = camera_frame_;
+    std_msgs::Header dh = h;
+    if (approx_) dh.stamp += ros::Duration(0.007);
+    return {acvo_test::colorMsg(img.rgb, color_encoding_, h),
+            acvo_test::depthMsg(img.depth, depth_encoding_, dh),
+            acvo_test::infoMsg(acvo_test::testCamera(), h)};
+  }
+  void publish(const Messages& m) {
+    info_pub_.publish(m.info);
+    depth_pub_.publish(m.depth);
+    rgb_pub_.publish(m.rgb);
+  }
 
   // Publishes one frame; `mutate` may spoil any of the three messages.
   template <typename Mutate>
@@ -310,6 +338,7 @@ class Client {
   std::string depth_encoding_, color_encoding_, camera_frame_, odom_frame_, base_frame_;
   bool approx_ = true, exact_stamps_ = false;
   bool late_base_tf_ = false;  // the .test publishes no base transform: the test sends it
+  bool burst_ = false;         // a fresh nodelet for the burst test (stamps on the wall clock)
   // The nodelet's initial_pose, when the .test sets one ("x y z roll pitch yaw").
   std::optional<Eigen::Isometry3d> initial_pose_;
   Eigen::Isometry3d base_from_camera_;
@@ -1010,6 +1039,63 @@ TEST(OdometryNodelet, PauseDropsFramesAndResumeGoesOn) {
   EXPECT_EQ(client->infoCount(paused.front()), 0);
   expectPoseNear(after.back().odom->pose.pose, client->expectedBase(cameraPose(8)), 8,
                  "3 frames after a pause of 2 frames");
+}
+
+// A camera faster than the odometry (a slow machine, a slow frame): the subscriber queues
+// (topic_queue_size 2) keep the newest frames and drop the older ones, so that the latency stays
+// a few frames' processing instead of growing with a backlog, as it did when the subscriber
+// queues were the synchroniser's 10. Stamps are the wall clock's here, so that
+// odom_info.ms_latency is the time from the stamp to publishing.
+TEST(OdometryNodelet, AFasterCameraIsDroppedNotQueued) {
+  if (!client->burst_) GTEST_SKIP() << "needs nodelet_burst.test (a fresh nodelet, exact sync)";
+  // One frame at a time: the time one frame takes, and its latency.
+  std::vector<double> alone_total;
+  for (int k = 0; k < 4; ++k) {
+    const ros::Time t = ros::Time::now();
+    client->send(client->frame(k), t);
+    const Outcome o = client->outcome(t, true);
+    ASSERT_TRUE(o.info && o.odom) << "frame " << k;
+    alone_total.push_back(o.info->ms_total);
+    // The latency holds the processing and the transport of the images.
+    EXPECT_GE(o.info->ms_latency, o.info->ms_total);
+    std::cout << "[ MEASURED ] alone, frame " << k << ": ms_total " << o.info->ms_total
+              << ", ms_latency " << o.info->ms_latency << "\n";
+  }
+  const double slowest = *std::max_element(alone_total.begin(), alone_total.end());
+  // The stream: kFrames frames at a third of the time one takes.
+  constexpr int kFrames = 30;
+  const double period = slowest / 3000.0;  // s
+  std::vector<ros::Time> stamps;
+  std::vector<Client::Messages> stream;
+  for (int i = 0; i < kFrames; ++i) client->frame(4 + i);  // rendered ahead
+  const ros::Time start = ros::Time::now() + ros::Duration(0.5);
+  for (int i = 0; i < kFrames; ++i) {
+    stamps.push_back(start + ros::Duration(period * i));
+    stream.push_back(client->messages(client->frame(4 + i), stamps.back()));
+  }
+  for (int i = 0; i < kFrames; ++i) {
+    const ros::Duration wait = stamps[i] - ros::Time::now();
+    if (wait > ros::Duration(0)) wait.sleep();
+    client->publish(stream[i]);
+  }
+  // The last frame comes out: everything before it is done then.
+  const Outcome last = client->outcome(stamps.back(), true);
+  ASSERT_TRUE(last.info && last.odom) << "the newest frame must be processed";
+  std::vector<double> latency;
+  for (const ros::Time& t : stamps) {
+    const Outcome o = client->outcome(t, false, 0.01);
+    if (o.info) latency.push_back(o.info->ms_latency);
+  }
+  const double worst = *std::max_element(latency.begin(), latency.end());
+  std::cout << "[ MEASURED ] " << kFrames << " frames every " << period * 1000.0
+            << " ms (one takes up to " << slowest << " ms alone): " << latency.size()
+            << " processed; latency first " << latency.front() << " ms, last " << latency.back()
+            << " ms, worst " << worst << " ms\n";
+  // A backlog would process every frame, each later than the one before (the last one about
+  // kFrames * (slowest - period) late); the short queues drop about two frames in three.
+  EXPECT_LE(latency.size(), std::size_t{kFrames / 2});
+  EXPECT_LT(worst, kQueuedFrames * slowest + kLatencySlack);
+  EXPECT_TRUE(isTracking(last.info->tracking)) << last.info->message;
 }
 
 TEST(OdometryNodelet, MissingBaseTransformIsReportedNotReplacedByIdentity) {
