@@ -92,7 +92,7 @@ class OdometryNodelet : public nodelet::Nodelet {
   std::string baseFrame() const;
   bool baseIsCamera() const;
   std::optional<Eigen::Isometry3d> lookup(const std::string& target, const std::string& source,
-                                          const ros::Time& stamp, std::string* error);
+                                          const ros::Time& stamp, double wait, std::string* error);
   std::optional<Eigen::Isometry3d> baseFromCamera();
   FrameTf frameTf(const ros::Time& stamp);
   void publish(const acvo::OdometryResult& r, const std_msgs::Header& header, const FrameTf& tf);
@@ -158,7 +158,8 @@ class OdometryNodelet : public nodelet::Nodelet {
   // A base pose to start from (initial_pose, or reset_odom_to_pose before the camera-to-base
   // transform was known): applied at the first frame whose transform is known.
   std::optional<Eigen::Isometry3d> pending_base_pose_;
-  ros::Time last_stamp_;                             // stamp of the last frame processed
+  bool guess_found_ = true;  // the last lookup of guess_frame_id succeeded: worth waiting for
+  ros::Time last_stamp_;     // stamp of the last frame processed
   std::optional<std::uint64_t> published_keyframe_;  // last keyframe sent on keyframe_cloud
   Counters count_;
   LastFrame last_;
@@ -393,11 +394,10 @@ bool OdometryNodelet::baseIsCamera() const {
 
 std::optional<Eigen::Isometry3d> OdometryNodelet::lookup(const std::string& target,
                                                          const std::string& source,
-                                                         const ros::Time& stamp,
+                                                         const ros::Time& stamp, double wait,
                                                          std::string* error) {
   // Poll on wall time: under use_sim_time a paused clock must not stall the callback.
-  const ros::WallTime deadline =
-      ros::WallTime::now() + ros::WallDuration(settings_.wait_for_transform_duration);
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(wait);
   while (true) {
     error->clear();  // canTransform appends
     if (tf_buffer_->canTransform(target, source, stamp, error)) {
@@ -413,7 +413,8 @@ std::optional<Eigen::Isometry3d> OdometryNodelet::baseFromCamera() {
   if (base_from_camera_) return base_from_camera_;
   const std::string base = baseFrame();
   std::string error;
-  base_from_camera_ = lookup(base, camera_frame_, ros::Time(0), &error);
+  base_from_camera_ =
+      lookup(base, camera_frame_, ros::Time(0), settings_.wait_for_transform_duration, &error);
   if (base_from_camera_) {
     NODELET_INFO("camera '%s' in base '%s': looked up once", camera_frame_.c_str(), base.c_str());
   } else {
@@ -432,12 +433,16 @@ OdometryNodelet::FrameTf OdometryNodelet::frameTf(const ros::Time& stamp) {
   const std::string& guess = settings_.guess_frame_id;
   const std::string base = baseFrame();
   std::string error;
-  tf.guess_from_base = lookup(guess, base, stamp, &error);
+  // Wait for the guess frame's transform at this stamp (wheel odometry may come a little after
+  // the image), but not frame after frame while it is missing: that would stall every frame.
+  const double wait = guess_found_ ? settings_.wait_for_transform_duration : 0.0;
+  tf.guess_from_base = lookup(guess, base, stamp, wait, &error);
+  guess_found_ = tf.guess_from_base.has_value();
   const std::optional<double> last = odometry_->lastTrackedStamp();
   if (tf.guess_from_base && last) {
     ros::Time then;
     then.fromSec(*last);
-    const std::optional<Eigen::Isometry3d> before = lookup(guess, base, then, &error);
+    const std::optional<Eigen::Isometry3d> before = lookup(guess, base, then, 0.0, &error);
     if (before) {
       // The base's motion from the last tracked frame to this one, seen from the camera.
       tf.motion_guess =
