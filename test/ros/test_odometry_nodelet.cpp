@@ -1041,37 +1041,40 @@ TEST(OdometryNodelet, PauseDropsFramesAndResumeGoesOn) {
                  "3 frames after a pause of 2 frames");
 }
 
-// A camera faster than the odometry (a slow machine, a slow frame): the subscriber queues
-// (topic_queue_size 2) keep the newest frames and drop the older ones, so that the latency stays
-// a few frames' processing instead of growing with a backlog, as it did when the subscriber
-// queues were the synchroniser's 10. Stamps are the wall clock's here, so that
+// A camera four times faster than the odometry (a slow machine, a slow frame): the subscriber
+// queues (topic_queue_size 2) keep the newest frames and drop the older ones, so that the
+// latency stays a few frames' processing instead of growing with a backlog, as it did when the
+// subscriber queues were the synchroniser's 10. Stamps are the wall clock's here, so that
 // odom_info.ms_latency is the time from the stamp to publishing.
 TEST(OdometryNodelet, AFasterCameraIsDroppedNotQueued) {
   if (!client->burst_) GTEST_SKIP() << "needs nodelet_burst.test (a fresh nodelet, exact sync)";
   // One frame at a time: the time one frame takes, and its latency.
   std::vector<double> alone_total;
-  for (int k = 0; k < 4; ++k) {
+  for (int k = 0; k < 6; ++k) {
     const ros::Time t = ros::Time::now();
     client->send(client->frame(k), t);
     const Outcome o = client->outcome(t, true);
     ASSERT_TRUE(o.info && o.odom) << "frame " << k;
-    alone_total.push_back(o.info->ms_total);
+    if (k > 0) alone_total.push_back(o.info->ms_total);  // the first warms the engine up
     // The latency holds the processing and the transport of the images.
     EXPECT_GE(o.info->ms_latency, o.info->ms_total);
     std::cout << "[ MEASURED ] alone, frame " << k << ": ms_total " << o.info->ms_total
               << ", ms_latency " << o.info->ms_latency << "\n";
   }
-  const double slowest = *std::max_element(alone_total.begin(), alone_total.end());
-  // The stream: kFrames frames at a third of the time one takes.
+  std::sort(alone_total.begin(), alone_total.end());
+  const double typical = alone_total[alone_total.size() / 2];
+  const double slowest = alone_total.back();
+  // The stream: kFrames frames at a quarter of the time one typically takes (a load spike
+  // during the frames alone must not make the camera slower than the odometry).
   constexpr int kFrames = 30;
-  const double period = slowest / 3000.0;  // s
+  const double period = typical / 4000.0;  // s
   std::vector<ros::Time> stamps;
   std::vector<Client::Messages> stream;
-  for (int i = 0; i < kFrames; ++i) client->frame(4 + i);  // rendered ahead
+  for (int i = 0; i < kFrames; ++i) client->frame(6 + i);  // rendered ahead
   const ros::Time start = ros::Time::now() + ros::Duration(0.5);
   for (int i = 0; i < kFrames; ++i) {
     stamps.push_back(start + ros::Duration(period * i));
-    stream.push_back(client->messages(client->frame(4 + i), stamps.back()));
+    stream.push_back(client->messages(client->frame(6 + i), stamps.back()));
   }
   for (int i = 0; i < kFrames; ++i) {
     const ros::Duration wait = stamps[i] - ros::Time::now();
@@ -1088,12 +1091,13 @@ TEST(OdometryNodelet, AFasterCameraIsDroppedNotQueued) {
   }
   const double worst = *std::max_element(latency.begin(), latency.end());
   std::cout << "[ MEASURED ] " << kFrames << " frames every " << period * 1000.0
-            << " ms (one takes up to " << slowest << " ms alone): " << latency.size()
-            << " processed; latency first " << latency.front() << " ms, last " << latency.back()
-            << " ms, worst " << worst << " ms\n";
-  // A backlog would process every frame, each later than the one before (the last one about
-  // kFrames * (slowest - period) late); the short queues drop about two frames in three.
-  EXPECT_LE(latency.size(), std::size_t{kFrames / 2});
+            << " ms (one takes " << typical << " ms alone, up to " << slowest
+            << " ms): " << latency.size() << " processed; latency first " << latency.front()
+            << " ms, last " << latency.back() << " ms, worst " << worst << " ms\n";
+  // A backlog processes every frame it holds, each later than the one before. Measured: with
+  // the queues of 2, 9 of 30 processed, worst latency 110-123 ms (three runs); with 10 per
+  // topic (as before) 16-21 processed and 455-475 ms.
+  EXPECT_LE(latency.size(), std::size_t{kFrames * 2 / 5});
   EXPECT_LT(worst, kQueuedFrames * slowest + kLatencySlack);
   EXPECT_TRUE(isTracking(last.info->tracking)) << last.info->message;
 }
