@@ -174,6 +174,36 @@ CameraResult cameraFor(const sensor_msgs::CameraInfo& info, int width, int heigh
   return out;
 }
 
+std::variant<acvo::Frame, Rejection> frameFromMessages(const sensor_msgs::Image& rgb,
+                                                       const sensor_msgs::Image& depth,
+                                                       const sensor_msgs::CameraInfo& info,
+                                                       const IntrinsicsOverride& intrinsics,
+                                                       const InputTopics& topics) {
+  if (stripSlash(rgb.header.frame_id).empty()) {
+    return Rejection{"the colour image on " + topics.rgb + " has no frame_id"};
+  }
+  ColorImage color = decodeColor(rgb);
+  if (!color.problem.empty()) return Rejection{color.problem + " on " + topics.rgb};
+  DepthImage metres = decodeDepth(depth);
+  if (!metres.problem.empty()) return Rejection{metres.problem + " on " + topics.depth};
+  if (rgb.width != depth.width || rgb.height != depth.height) {
+    return Rejection{"colour (" + topics.rgb + ", " + std::to_string(rgb.width) + "x" +
+                     std::to_string(rgb.height) + ") and depth (" + topics.depth + ", " +
+                     std::to_string(depth.width) + "x" + std::to_string(depth.height) +
+                     ") differ in size: the depth must be registered to the colour image"};
+  }
+  CameraResult camera = cameraFor(info, rgb.width, rgb.height, intrinsics);
+  if (!camera.problem.empty()) return Rejection{camera.problem + " (" + topics.info + ")"};
+  acvo::Frame frame;
+  frame.color = color.image;
+  frame.order = color.order;
+  frame.depth = metres.metres;
+  frame.camera = camera.camera;
+  frame.stamp = rgb.header.stamp.toSec();
+  if (std::string problem = frame.problem(); !problem.empty()) return Rejection{problem};
+  return frame;
+}
+
 Eigen::Isometry3d conjugate(const Eigen::Isometry3d& base_from_cam, const Eigen::Isometry3d& t) {
   return base_from_cam * t * base_from_cam.inverse();
 }

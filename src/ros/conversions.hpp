@@ -4,6 +4,7 @@
 #pragma once
 
 #include <string>
+#include <variant>
 
 #include <geometry_msgs/Pose.h>
 #include <geometry_msgs/TransformStamped.h>
@@ -64,6 +65,25 @@ struct CameraResult {
 // and whose focal lengths must be positive).
 CameraResult cameraFor(const sensor_msgs::CameraInfo& info, int width, int height,
                        const IntrinsicsOverride& override_intrinsics);
+
+// The names of the three input topics, for messages about them.
+struct InputTopics {
+  std::string rgb, depth, info;
+};
+
+// Why a set of messages was not made into a frame: a sentence naming the cause and the topic.
+struct Rejection {
+  std::string why;
+};
+
+// The frame of one synchronised set (colour, registered depth, camera info), or why there is
+// none: no frame id, an unsupported or malformed encoding, colour and depth of different sizes,
+// unusable intrinsics. The stamp is the colour image's.
+std::variant<acvo::Frame, Rejection> frameFromMessages(const sensor_msgs::Image& rgb,
+                                                       const sensor_msgs::Image& depth,
+                                                       const sensor_msgs::CameraInfo& info,
+                                                       const IntrinsicsOverride& intrinsics,
+                                                       const InputTopics& topics);
 
 // Optical-frame camera motion seen from a base frame rigidly attached to the camera:
 // T_base_cam * T * T_base_cam^-1.

@@ -38,8 +38,20 @@ nav_msgs::Odometry toOdometryMsg(const acvo::OdometryResult& result,
   return odom;
 }
 
+nav_msgs::Odometry nullOdometryMsg(const std_msgs::Header& header, const std::string& child) {
+  nav_msgs::Odometry odom;
+  odom.header = header;
+  odom.child_frame_id = child;
+  odom.pose.pose.orientation.w = 0.0;  // geometry_msgs defaults to 0 already: said for the reader
+  for (int d = 0; d < 6; ++d) {
+    odom.pose.covariance[7 * d] = kLostVariance;
+    odom.twist.covariance[7 * d] = kLostVariance;
+  }
+  return odom;
+}
+
 acvo::OdometryInfo toInfoMsg(const acvo::OdometryResult& result, const std_msgs::Header& header,
-                             double ms_total, std::uint32_t lost_count) {
+                             const InfoExtras& extras) {
   acvo::OdometryInfo info;
   info.header = header;
   info.lost = result.tracking == acvo::Tracking::kLost;
@@ -58,17 +70,20 @@ acvo::OdometryInfo toInfoMsg(const acvo::OdometryResult& result, const std_msgs:
   info.new_keyframe = result.new_keyframe;
   info.fell_back_to_previous = result.fell_back_to_previous;
   info.interval = result.interval;
+  info.guess_from_tf = extras.guess_from_tf;
   info.ms_cloud = result.ms_cloud;
   info.ms_registration = result.ms_registration;
-  info.ms_total = ms_total;
-  info.lost_count = lost_count;
+  info.ms_total = extras.ms_total;
+  info.ms_latency = extras.ms_latency;
+  info.lost_count = extras.lost_count;
   info.message = result.message;
   return info;
 }
 
 DiagnosticSummary summarise(bool synchronised, double seconds_since_frame, double no_data_timeout,
-                            acvo::Tracking last) {
+                            acvo::Tracking last, bool paused) {
   using diagnostic_msgs::DiagnosticStatus;
+  if (paused) return {DiagnosticStatus::WARN, "paused"};
   if (!synchronised || seconds_since_frame > no_data_timeout) {
     return {DiagnosticStatus::ERROR, "no data"};
   }

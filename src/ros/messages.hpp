@@ -26,17 +26,28 @@ nav_msgs::Odometry toOdometryMsg(const acvo::OdometryResult& result,
                                  const Eigen::Isometry3d& base_from_camera,
                                  const std_msgs::Header& header, const std::string& child);
 
-acvo::OdometryInfo toInfoMsg(const acvo::OdometryResult& result, const std_msgs::Header& header,
-                             double ms_total, std::uint32_t lost_count);
+// rtabmap's "null" odometry for a lost frame (lost_odom null): header and child, a zero pose
+// with an all-zero quaternion, a zero twist, kLostVariance on both covariance diagonals.
+nav_msgs::Odometry nullOdometryMsg(const std_msgs::Header& header, const std::string& child);
 
-// What diagnostics say: "no data" (ERROR) when nothing was synchronised yet or for longer than
-// `no_data_timeout` s; otherwise from the last frame: OK "tracking" (ok, first frame), WARN
-// "hard to track", ERROR "lost", ERROR "bad input".
+// What the nodelet adds to the result in odom_info.
+struct InfoExtras {
+  double ms_total = 0.0;    // the whole callback (ms)
+  double ms_latency = 0.0;  // image stamp to publishing (ms, ROS clock)
+  std::uint32_t lost_count = 0;
+  bool guess_from_tf = false;
+};
+acvo::OdometryInfo toInfoMsg(const acvo::OdometryResult& result, const std_msgs::Header& header,
+                             const InfoExtras& extras);
+
+// What diagnostics say: WARN "paused" while paused (pause_odom); "no data" (ERROR) when nothing
+// was synchronised yet or for longer than `no_data_timeout` s; otherwise from the last frame:
+// OK "tracking" (ok, first frame), WARN "hard to track", ERROR "lost", ERROR "bad input".
 struct DiagnosticSummary {
   std::uint8_t level = 0;  // diagnostic_msgs::DiagnosticStatus level
   std::string message;
 };
 DiagnosticSummary summarise(bool synchronised, double seconds_since_frame, double no_data_timeout,
-                            acvo::Tracking last);
+                            acvo::Tracking last, bool paused = false);
 
 }  // namespace acvo_ros

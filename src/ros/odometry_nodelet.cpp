@@ -1,6 +1,10 @@
 // The ROS face of acvo: synchronised colour + depth + camera info in, odometry, TF, the
 // labelled cloud, a per-frame report and diagnostics out. The nodelet converts messages, calls
 // acvo::Odometry and publishes; the method lives in the core library.
+//
+// One frame's path: onFrame (lock) -> processFrame: stamp rules, conversion (a rejection is
+// handled in reject(), the one place), the camera-to-base transform, the motion guess from TF,
+// the odometry, then publish() and publishInfo().
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -8,6 +12,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <variant>
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <dynamic_reconfigure/server.h>
@@ -36,6 +41,7 @@
 #include "conversions.hpp"
 #include "covariance.hpp"
 #include "messages.hpp"
+#include "nodelet_settings.hpp"
 #include "ros_params.hpp"
 #include "stamp_check.hpp"
 
@@ -51,6 +57,8 @@ constexpr double kTimeJumpBack = 1.0;
 constexpr double kNoSyncWarning = 5.0;
 // Period of the warning about each cause of a skipped frame (s).
 constexpr double kSkipWarning = 5.0;
+// Period of the warning about a motion guess that could not be looked up (s).
+constexpr double kGuessWarning = 10.0;
 
 double msSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
@@ -65,37 +73,45 @@ class OdometryNodelet : public nodelet::Nodelet {
   using ExactPolicy = message_filters::sync_policies::ExactTime<Image, Image, Info>;
   using ApproxPolicy = message_filters::sync_policies::ApproximateTime<Image, Image, Info>;
 
+  // What came out of TF for one frame.
+  struct FrameTf {
+    std::optional<Eigen::Isometry3d> base_from_camera;
+    std::optional<Eigen::Isometry3d> motion_guess;     // camera: this frame -> last tracked one
+    std::optional<Eigen::Isometry3d> guess_from_base;  // the base in guess_frame_id, now
+  };
+
   void onInit() override;
-  void loadParameters();
+  void loadSettings();
   void subscribe();
 
   void onFrame(const ImageConstPtr& rgb, const ImageConstPtr& depth,
                const CameraInfoConstPtr& info);
   void processFrame(const Image& rgb, const Image& depth, const Info& info);
   bool acceptStamp(const ros::Time& stamp);
-  std::optional<acvo::Frame> toFrame(const Image& rgb, const Image& depth, const Info& info);
+  void reject(const std_msgs::Header& header, const std::string& why, double ms_total);
   std::string baseFrame() const;
+  bool baseIsCamera() const;
+  std::optional<Eigen::Isometry3d> lookup(const std::string& target, const std::string& source,
+                                          const ros::Time& stamp, double wait, std::string* error);
   std::optional<Eigen::Isometry3d> baseFromCamera();
-  void publish(const acvo::OdometryResult& r, const std_msgs::Header& header);
-  void publishInfo(const acvo::OdometryResult& r, const std_msgs::Header& header, double ms_total);
-  void rejectFrame(const std_msgs::Header& header, const std::string& why, double ms_total);
+  FrameTf frameTf(const ros::Time& stamp);
+  void publish(const acvo::OdometryResult& r, const std_msgs::Header& header, const FrameTf& tf);
+  void publishInfo(const acvo::OdometryResult& r, const std_msgs::Header& header,
+                   const InfoExtras& extras);
   void restart(const Eigen::Isometry3d& camera_pose);
+  void startAt(const Eigen::Isometry3d& base_pose, const Eigen::Isometry3d& base_from_camera);
 
   bool onReset(std_srvs::Empty::Request&, std_srvs::Empty::Response&);
   bool onResetToPose(acvo::ResetToPose::Request& req, acvo::ResetToPose::Response& res);
+  bool onPause(std_srvs::Empty::Request&, std_srvs::Empty::Response&);
+  bool onResume(std_srvs::Empty::Request&, std_srvs::Empty::Response&);
   void onReconfigure(acvo::AcvoConfig& config, uint32_t level);
   void onWatchdog(const ros::WallTimerEvent&);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat);
 
-  // Settings (set in onInit, publish_null_when_lost also by dynamic_reconfigure).
-  std::string odom_frame_, base_frame_param_;
-  bool base_is_optical_ = false;  // base_frame_param_ renames the optical frame: no lookup
-  bool publish_tf_ = true;
-  double wait_for_transform_ = 0.2;
-  double max_time_gap_ = 1.0;
-  double no_data_timeout_ = 3.0;
-  bool publish_null_when_lost_ = false;
-  IntrinsicsOverride intrinsics_;
+  // Set in onInit; lost_odom also by dynamic_reconfigure.
+  NodeletSettings settings_;
+  InputTopics topics_;
 
   ros::NodeHandle nh_, pnh_;
   std::unique_ptr<image_transport::ImageTransport> it_;
@@ -104,7 +120,7 @@ class OdometryNodelet : public nodelet::Nodelet {
   std::unique_ptr<message_filters::Synchronizer<ExactPolicy>> exact_sync_;
   std::unique_ptr<message_filters::Synchronizer<ApproxPolicy>> approx_sync_;
   ros::Publisher odom_pub_, cloud_pub_, keyframe_cloud_pub_, info_pub_;
-  ros::ServiceServer reset_srv_, reset_to_pose_srv_;
+  ros::ServiceServer reset_srv_, reset_to_pose_srv_, pause_srv_, resume_srv_;
   std::unique_ptr<tf2_ros::Buffer> tf_buffer_;
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
   std::unique_ptr<tf2_ros::TransformBroadcaster> tf_broadcaster_;
@@ -113,23 +129,40 @@ class OdometryNodelet : public nodelet::Nodelet {
   std::unique_ptr<diagnostic_updater::Updater> updater_;
   ros::WallTimer watchdog_;
 
+  // Counts, for odom_info, diagnostics and the no-data warning. The message counts are
+  // incremented by the subscribers' callbacks, outside the mutex.
+  struct Counters {
+    std::uint64_t frames = 0;  // frames given to the odometry
+    std::uint32_t lost = 0;
+    std::uint64_t paused = 0;  // synchronised frames dropped while paused
+    std::atomic<std::uint64_t> rgb{0}, depth{0}, info{0};
+  };
+  // What the last frame left, for diagnostics.
+  struct LastFrame {
+    bool synchronised = false;  // a frame came out of the synchroniser
+    acvo::Tracking tracking = acvo::Tracking::kFirstFrame;
+    std::string message;
+    double ms_total = 0.0;
+    double ms_latency = 0.0;
+    ros::WallTime wall;  // last synchronised frame, good or bad
+  };
+
   // State, guarded by mutex_ (frames, services, reconfigure and timers may run concurrently
   // when the manager has several worker threads).
   std::mutex mutex_;
   acvo::Params params_;
   std::unique_ptr<acvo::Odometry> odometry_;
+  bool paused_ = false;
   std::string camera_frame_;                           // optical frame of the last image
   std::optional<Eigen::Isometry3d> base_from_camera_;  // looked up once per camera frame
-  ros::Time last_stamp_;                               // stamp of the last frame processed
-  std::uint32_t lost_count_ = 0;
-  std::uint64_t frames_ = 0;                         // frames given to the odometry
+  // A base pose to start from (initial_pose, or reset_odom_to_pose before the camera-to-base
+  // transform was known): applied at the first frame whose transform is known.
+  std::optional<Eigen::Isometry3d> pending_base_pose_;
+  bool guess_found_ = true;  // the last lookup of guess_frame_id succeeded: worth waiting for
+  ros::Time last_stamp_;     // stamp of the last frame processed
   std::optional<std::uint64_t> published_keyframe_;  // last keyframe sent on keyframe_cloud
-  bool synchronised_ = false;                        // a frame came out of the synchroniser
-  acvo::Tracking last_tracking_ = acvo::Tracking::kFirstFrame;
-  std::string last_message_;
-  double last_ms_total_ = 0.0;
-  ros::WallTime last_frame_wall_;  // last synchronised frame, good or bad
-  std::atomic<std::uint64_t> rgb_count_{0}, depth_count_{0}, info_count_{0};
+  Counters count_;
+  LastFrame last_;
   ros::WallTime last_sync_warning_;
   CauseThrottle skip_warnings_{kSkipWarning};  // why frames are skipped, one slot per cause
 };
@@ -137,7 +170,7 @@ class OdometryNodelet : public nodelet::Nodelet {
 void OdometryNodelet::onInit() {
   nh_ = getNodeHandle();
   pnh_ = getPrivateNodeHandle();
-  loadParameters();
+  loadSettings();
 
   odom_pub_ = nh_.advertise<nav_msgs::Odometry>("odom", 10);
   cloud_pub_ = nh_.advertise<sensor_msgs::PointCloud2>("cloud", 2);
@@ -147,6 +180,8 @@ void OdometryNodelet::onInit() {
   reset_srv_ = nh_.advertiseService("reset_odom", &OdometryNodelet::onReset, this);
   reset_to_pose_srv_ =
       nh_.advertiseService("reset_odom_to_pose", &OdometryNodelet::onResetToPose, this);
+  pause_srv_ = nh_.advertiseService("pause_odom", &OdometryNodelet::onPause, this);
+  resume_srv_ = nh_.advertiseService("resume_odom", &OdometryNodelet::onResume, this);
   tf_buffer_ = std::make_unique<tf2_ros::Buffer>();
   tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_, nh_);
   tf_broadcaster_ = std::make_unique<tf2_ros::TransformBroadcaster>();
@@ -154,7 +189,7 @@ void OdometryNodelet::onInit() {
   // Start the server from the loaded values rather than from the .cfg defaults.
   reconfigure_ =
       std::make_unique<dynamic_reconfigure::Server<acvo::AcvoConfig>>(reconfigure_mutex_, pnh_);
-  reconfigure_->updateConfig(toConfig(params_, publish_null_when_lost_));
+  reconfigure_->updateConfig(toConfig(params_, settings_.lost_odom));
   reconfigure_->setCallback(
       [this](acvo::AcvoConfig& config, uint32_t level) { onReconfigure(config, level); });
 
@@ -163,35 +198,19 @@ void OdometryNodelet::onInit() {
   updater_->add("odometry", this, &OdometryNodelet::diagnose);
 
   subscribe();
-  last_sync_warning_ = last_frame_wall_ = ros::WallTime::now();
+  last_sync_warning_ = last_.wall = ros::WallTime::now();
   watchdog_ = nh_.createWallTimer(ros::WallDuration(1.0), &OdometryNodelet::onWatchdog, this);
 }
 
-void OdometryNodelet::loadParameters() {
-  pnh_.param<std::string>("odom_frame_id", odom_frame_, "odom");
-  odom_frame_ = stripSlash(odom_frame_);
-  pnh_.param<std::string>("base_frame_id", base_frame_param_, "");
-  base_frame_param_ = stripSlash(base_frame_param_);
-  pnh_.param("base_is_optical_frame", base_is_optical_, false);
-  pnh_.param("publish_tf", publish_tf_, true);
-  pnh_.param("wait_for_transform_duration", wait_for_transform_, 0.2);
-  pnh_.param("max_time_gap", max_time_gap_, 1.0);
-  pnh_.param("no_data_timeout", no_data_timeout_, 3.0);
-  pnh_.param("publish_null_when_lost", publish_null_when_lost_, false);
-  pnh_.param<std::string>("camera", intrinsics_.camera, "");
-  pnh_.param("fx", intrinsics_.fx, 0.0);
-  pnh_.param("fy", intrinsics_.fy, 0.0);
-  pnh_.param("cx", intrinsics_.cx, 0.0);
-  pnh_.param("cy", intrinsics_.cy, 0.0);
-  const std::string intrinsics_problem = intrinsics_.problem();
-  if (!intrinsics_problem.empty()) {
-    NODELET_ERROR("%s: ignoring the override, intrinsics come from camera_info",
-                  intrinsics_problem.c_str());
-    intrinsics_ = IntrinsicsOverride();
-  }
-
+void OdometryNodelet::loadSettings() {
   XmlRpc::XmlRpcValue private_ns;
   ros::param::get(pnh_.getNamespace(), private_ns);
+  for (const std::string& problem : loadNodeletSettings(private_ns, settings_)) {
+    NODELET_ERROR("parameter problem: %s", problem.c_str());
+  }
+  NODELET_INFO("nodelet settings: %s", describe(settings_).c_str());
+  pending_base_pose_ = settings_.initial_pose;
+
   acvo::Params params;
   for (const std::string& problem : applyRosParams(private_ns, params)) {
     NODELET_ERROR("parameter problem: %s", problem.c_str());
@@ -208,46 +227,42 @@ void OdometryNodelet::loadParameters() {
 }
 
 void OdometryNodelet::subscribe() {
-  bool approx = true;
-  double max_interval = 0.0;
-  int queue_size = 10;
-  pnh_.param("approx_sync", approx, true);
-  pnh_.param("approx_sync_max_interval", max_interval, 0.0);
-  pnh_.param("queue_size", queue_size, 10);
-  queue_size = std::max(queue_size, 1);
-
+  const NodeletSettings& s = settings_;
   it_ = std::make_unique<image_transport::ImageTransport>(nh_);
   const image_transport::TransportHints rgb_hints("raw", ros::TransportHints(), pnh_,
                                                   "image_transport");
   const image_transport::TransportHints depth_hints("raw", ros::TransportHints(), pnh_,
                                                     "depth_image_transport");
-  rgb_sub_.subscribe(*it_, "rgb/image", queue_size, rgb_hints);
-  depth_sub_.subscribe(*it_, "depth/image", queue_size, depth_hints);
-  info_sub_.subscribe(nh_, "rgb/camera_info", queue_size);
+  rgb_sub_.subscribe(*it_, "rgb/image", s.topic_queue_size, rgb_hints);
+  depth_sub_.subscribe(*it_, "depth/image", s.topic_queue_size, depth_hints);
+  info_sub_.subscribe(nh_, "rgb/camera_info", s.topic_queue_size);
+  topics_ = {rgb_sub_.getTopic(), depth_sub_.getTopic(), info_sub_.getTopic()};
   rgb_sub_.registerCallback(
-      boost::function<void(const ImageConstPtr&)>([this](const ImageConstPtr&) { ++rgb_count_; }));
+      boost::function<void(const ImageConstPtr&)>([this](const ImageConstPtr&) { ++count_.rgb; }));
   depth_sub_.registerCallback(boost::function<void(const ImageConstPtr&)>(
-      [this](const ImageConstPtr&) { ++depth_count_; }));
+      [this](const ImageConstPtr&) { ++count_.depth; }));
   info_sub_.registerCallback(boost::function<void(const CameraInfoConstPtr&)>(
-      [this](const CameraInfoConstPtr&) { ++info_count_; }));
+      [this](const CameraInfoConstPtr&) { ++count_.info; }));
 
   using namespace boost::placeholders;
   const auto callback = boost::bind(&OdometryNodelet::onFrame, this, _1, _2, _3);
-  if (approx) {
+  if (s.approx_sync) {
     approx_sync_ = std::make_unique<message_filters::Synchronizer<ApproxPolicy>>(
-        ApproxPolicy(queue_size), rgb_sub_, depth_sub_, info_sub_);
-    if (max_interval > 0.0) approx_sync_->setMaxIntervalDuration(ros::Duration(max_interval));
+        ApproxPolicy(s.sync_queue_size), rgb_sub_, depth_sub_, info_sub_);
+    if (s.approx_sync_max_interval > 0.0) {
+      approx_sync_->setMaxIntervalDuration(ros::Duration(s.approx_sync_max_interval));
+    }
     approx_sync_->setReset(true);  // clear the queues when a replayed clock jumps back
     approx_sync_->registerCallback(callback);
   } else {
     exact_sync_ = std::make_unique<message_filters::Synchronizer<ExactPolicy>>(
-        ExactPolicy(queue_size), rgb_sub_, depth_sub_, info_sub_);
+        ExactPolicy(s.sync_queue_size), rgb_sub_, depth_sub_, info_sub_);
     exact_sync_->setReset(true);
     exact_sync_->registerCallback(callback);
   }
-  NODELET_INFO("subscribed to %s, %s, %s (%s sync, queue %d)", rgb_sub_.getTopic().c_str(),
-               depth_sub_.getTopic().c_str(), info_sub_.getTopic().c_str(),
-               approx ? "approximate" : "exact", queue_size);
+  NODELET_INFO("subscribed to %s, %s, %s (%s sync; queues: %d per topic, %d in the synchroniser)",
+               topics_.rgb.c_str(), topics_.depth.c_str(), topics_.info.c_str(),
+               s.approx_sync ? "approximate" : "exact", s.topic_queue_size, s.sync_queue_size);
 }
 
 void OdometryNodelet::onFrame(const ImageConstPtr& rgb, const ImageConstPtr& depth,
@@ -262,54 +277,81 @@ void OdometryNodelet::onFrame(const ImageConstPtr& rgb, const ImageConstPtr& dep
 
 void OdometryNodelet::processFrame(const Image& rgb, const Image& depth, const Info& info) {
   const auto start = std::chrono::steady_clock::now();
-  last_frame_wall_ = ros::WallTime::now();
-  synchronised_ = true;
+  last_.wall = ros::WallTime::now();
+  last_.synchronised = true;
+  if (paused_) {
+    ++count_.paused;
+    return;
+  }
   std_msgs::Header header = rgb.header;
   header.frame_id = stripSlash(rgb.header.frame_id);
   if (!acceptStamp(header.stamp)) return;
 
-  std::optional<acvo::Frame> frame = toFrame(rgb, depth, info);
-  if (!frame) return;
+  std::variant<acvo::Frame, Rejection> converted =
+      frameFromMessages(rgb, depth, info, settings_.intrinsics, topics_);
+  if (const Rejection* rejection = std::get_if<Rejection>(&converted)) {
+    reject(header, rejection->why, msSince(start));
+    return;
+  }
+  const acvo::Frame& frame = std::get<acvo::Frame>(converted);
+  if (frame.order == acvo::ColorOrder::kGray) {
+    NODELET_WARN_ONCE("%s is mono8: points get intensity and gradient labels but no colour",
+                      topics_.rgb.c_str());
+  }
+  if (!settings_.intrinsics.named() && !settings_.intrinsics.explicitValues() &&
+      std::any_of(info.D.begin(), info.D.end(), [](double d) { return d != 0.0; })) {
+    NODELET_WARN_ONCE("%s has non-zero distortion: the images are used as if rectified",
+                      topics_.info.c_str());
+  }
   if (header.frame_id != camera_frame_) {
     camera_frame_ = header.frame_id;
     base_from_camera_.reset();
   }
 
-  const acvo::OdometryResult r = odometry_->process(*frame);
-  ++frames_;
-  last_tracking_ = r.tracking;
-  last_message_ = r.message;
+  FrameTf tf = frameTf(header.stamp);
+  if (pending_base_pose_ && tf.base_from_camera) {
+    startAt(*pending_base_pose_, *tf.base_from_camera);
+    tf.motion_guess.reset();
+  }
+  const acvo::OdometryResult r = odometry_->process(frame, tf.motion_guess);
+  ++count_.frames;
+  last_.tracking = r.tracking;
+  last_.message = r.message;
+  InfoExtras extras;
+  extras.guess_from_tf = tf.motion_guess.has_value() && r.tracking != acvo::Tracking::kFirstFrame;
   if (r.tracking == acvo::Tracking::kBadFrame) {
-    if (skip_warnings_.allow(r.message, ros::WallTime::now().toSec())) {
-      NODELET_WARN("frame rejected by the odometry: %s", r.message.c_str());
-    }
-    publishInfo(r, header, msSince(start));
+    // The conversion checks what the odometry checks: this is a safety net.
+    reject(header, r.message, msSince(start));
     return;
   }
   last_stamp_ = header.stamp;
 
   if (r.tracking == acvo::Tracking::kLost) {
-    ++lost_count_;
+    ++count_.lost;
     NODELET_WARN_THROTTLE(2.0, "tracking lost (%s): holding the last pose, %s (%u lost so far)",
                           r.message.c_str(),
                           r.new_keyframe ? "the reference restarts from this frame"
                                          : "the next frame is registered to the last good one",
-                          lost_count_);
+                          count_.lost);
   }
-  publish(r, header);
-  publishInfo(r, header, msSince(start));
+  publish(r, header, tf);
+  // On the ROS clock, as the stamps are: sim time when a bag is played with --clock.
+  extras.ms_latency = (ros::Time::now() - header.stamp).toSec() * 1000.0;
+  extras.ms_total = msSince(start);
+  extras.lost_count = count_.lost;
+  publishInfo(r, header, extras);
 }
 
 bool OdometryNodelet::acceptStamp(const ros::Time& stamp) {
   const double last = last_stamp_.toSec();
-  switch (checkStamp(last, stamp.toSec(), max_time_gap_, kTimeJumpBack)) {
+  switch (checkStamp(last, stamp.toSec(), settings_.max_time_gap, kTimeJumpBack)) {
     case StampVerdict::kAccept:
       return true;
     case StampVerdict::kGap:
       NODELET_WARN_THROTTLE(5.0,
                             "%.3f s between frames (max_time_gap %.3f): continuing, the motion "
                             "guess may be poor",
-                            stamp.toSec() - last, max_time_gap_);
+                            stamp.toSec() - last, settings_.max_time_gap);
       return true;
     case StampVerdict::kDrop:
       NODELET_WARN_THROTTLE(5.0, "dropping a frame whose stamp %.6f is not after the last one %.6f",
@@ -325,122 +367,125 @@ bool OdometryNodelet::acceptStamp(const ros::Time& stamp) {
   return false;
 }
 
-void OdometryNodelet::rejectFrame(const std_msgs::Header& header, const std::string& why,
-                                  double ms_total) {
-  last_tracking_ = acvo::Tracking::kBadFrame;
-  last_message_ = why;
+void OdometryNodelet::reject(const std_msgs::Header& header, const std::string& why,
+                             double ms_total) {
+  last_.tracking = acvo::Tracking::kBadFrame;
+  last_.message = why;
   if (skip_warnings_.allow(why, ros::WallTime::now().toSec())) {
     NODELET_WARN("frame skipped: %s", why.c_str());
   }
   acvo::OdometryResult r;
   r.tracking = acvo::Tracking::kBadFrame;
   r.message = why;
-  publishInfo(r, header, ms_total);
-}
-
-std::optional<acvo::Frame> OdometryNodelet::toFrame(const Image& rgb, const Image& depth,
-                                                    const Info& info) {
-  const auto start = std::chrono::steady_clock::now();
-  std_msgs::Header header = rgb.header;
-  header.frame_id = stripSlash(rgb.header.frame_id);
-  if (header.frame_id.empty()) {
-    rejectFrame(header, "the colour image on " + rgb_sub_.getTopic() + " has no frame_id",
-                msSince(start));
-    return std::nullopt;
-  }
-  ColorImage color = decodeColor(rgb);
-  if (!color.problem.empty()) {
-    rejectFrame(header, color.problem + " on " + rgb_sub_.getTopic(), msSince(start));
-    return std::nullopt;
-  }
-  if (color.order == acvo::ColorOrder::kGray) {
-    NODELET_WARN_ONCE("%s is mono8: points get intensity and gradient labels but no colour",
-                      rgb_sub_.getTopic().c_str());
-  }
-  DepthImage metres = decodeDepth(depth);
-  if (!metres.problem.empty()) {
-    rejectFrame(header, metres.problem + " on " + depth_sub_.getTopic(), msSince(start));
-    return std::nullopt;
-  }
-  if (rgb.width != depth.width || rgb.height != depth.height) {
-    rejectFrame(header,
-                "colour (" + rgb_sub_.getTopic() + ", " + std::to_string(rgb.width) + "x" +
-                    std::to_string(rgb.height) + ") and depth (" + depth_sub_.getTopic() + ", " +
-                    std::to_string(depth.width) + "x" + std::to_string(depth.height) +
-                    ") differ in size: the depth must be registered to the colour image",
-                msSince(start));
-    return std::nullopt;
-  }
-  CameraResult camera = cameraFor(info, rgb.width, rgb.height, intrinsics_);
-  if (!camera.problem.empty()) {
-    rejectFrame(header, camera.problem + " (" + info_sub_.getTopic() + ")", msSince(start));
-    return std::nullopt;
-  }
-  if (!intrinsics_.named() && !intrinsics_.explicitValues() &&
-      std::any_of(info.D.begin(), info.D.end(), [](double d) { return d != 0.0; })) {
-    NODELET_WARN_ONCE("%s has non-zero distortion: the images are used as if rectified",
-                      info_sub_.getTopic().c_str());
-  }
-  acvo::Frame frame;
-  frame.color = color.image;
-  frame.order = color.order;
-  frame.depth = metres.metres;
-  frame.camera = camera.camera;
-  frame.stamp = rgb.header.stamp.toSec();
-  const std::string problem = frame.problem();
-  if (!problem.empty()) {
-    rejectFrame(header, problem, msSince(start));
-    return std::nullopt;
-  }
-  return frame;
+  InfoExtras extras;
+  extras.ms_total = ms_total;
+  extras.ms_latency = (ros::Time::now() - header.stamp).toSec() * 1000.0;
+  extras.lost_count = count_.lost;
+  publishInfo(r, header, extras);
 }
 
 std::string OdometryNodelet::baseFrame() const {
-  return base_frame_param_.empty() ? camera_frame_ : base_frame_param_;
+  return settings_.base_frame_id.empty() ? camera_frame_ : settings_.base_frame_id;
+}
+
+bool OdometryNodelet::baseIsCamera() const {
+  return settings_.base_is_optical_frame || baseFrame() == camera_frame_;
+}
+
+std::optional<Eigen::Isometry3d> OdometryNodelet::lookup(const std::string& target,
+                                                         const std::string& source,
+                                                         const ros::Time& stamp, double wait,
+                                                         std::string* error) {
+  // Poll on wall time: under use_sim_time a paused clock must not stall the callback.
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(wait);
+  while (true) {
+    error->clear();  // canTransform appends
+    if (tf_buffer_->canTransform(target, source, stamp, error)) {
+      return tf2::transformToEigen(tf_buffer_->lookupTransform(target, source, stamp));
+    }
+    if (ros::WallTime::now() >= deadline) return std::nullopt;
+    ros::WallDuration(0.005).sleep();
+  }
 }
 
 std::optional<Eigen::Isometry3d> OdometryNodelet::baseFromCamera() {
-  const std::string base = baseFrame();
-  if (base_is_optical_ || base == camera_frame_) return Eigen::Isometry3d::Identity();
+  if (baseIsCamera()) return Eigen::Isometry3d::Identity();
   if (base_from_camera_) return base_from_camera_;
-  // Poll on wall time: under use_sim_time a paused clock must not stall the callback.
-  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(wait_for_transform_);
+  const std::string base = baseFrame();
   std::string error;
-  while (true) {
-    error.clear();  // canTransform appends
-    if (tf_buffer_->canTransform(base, camera_frame_, ros::Time(0), &error)) {
-      base_from_camera_ =
-          tf2::transformToEigen(tf_buffer_->lookupTransform(base, camera_frame_, ros::Time(0)));
-      NODELET_INFO("camera '%s' in base '%s': looked up once", camera_frame_.c_str(), base.c_str());
-      return base_from_camera_;
-    }
-    if (ros::WallTime::now() >= deadline) break;
-    ros::WallDuration(0.005).sleep();
+  base_from_camera_ =
+      lookup(base, camera_frame_, ros::Time(0), settings_.wait_for_transform_duration, &error);
+  if (base_from_camera_) {
+    NODELET_INFO("camera '%s' in base '%s': looked up once", camera_frame_.c_str(), base.c_str());
+  } else {
+    NODELET_ERROR_THROTTLE(5.0,
+                           "no transform from base frame '%s' to camera frame '%s' (%s): "
+                           "odometry is not published until it is available",
+                           base.c_str(), camera_frame_.c_str(), error.c_str());
   }
-  NODELET_ERROR_THROTTLE(5.0,
-                         "no transform from base frame '%s' to camera frame '%s' (%s): odometry "
-                         "is not published until it is available",
-                         base.c_str(), camera_frame_.c_str(), error.c_str());
-  return std::nullopt;
+  return base_from_camera_;
 }
 
-void OdometryNodelet::publish(const acvo::OdometryResult& r, const std_msgs::Header& header) {
-  const std::optional<Eigen::Isometry3d> base_from_camera = baseFromCamera();
-  if (!base_from_camera) return;
+OdometryNodelet::FrameTf OdometryNodelet::frameTf(const ros::Time& stamp) {
+  FrameTf tf;
+  tf.base_from_camera = baseFromCamera();
+  if (settings_.guess_frame_id.empty() || !tf.base_from_camera) return tf;
+  const std::string& guess = settings_.guess_frame_id;
   const std::string base = baseFrame();
-  if (!(r.tracking == acvo::Tracking::kLost && publish_null_when_lost_)) {
-    std_msgs::Header odom_header;
-    odom_header.stamp = header.stamp;
-    odom_header.frame_id = odom_frame_;
-    const nav_msgs::Odometry odom = toOdometryMsg(r, *base_from_camera, odom_header, base);
-    odom_pub_.publish(odom);
-    if (publish_tf_) {
+  std::string error;
+  // Wait for the guess frame's transform at this stamp (wheel odometry may come a little after
+  // the image), but not frame after frame while it is missing: that would stall every frame.
+  const double wait = guess_found_ ? settings_.wait_for_transform_duration : 0.0;
+  tf.guess_from_base = lookup(guess, base, stamp, wait, &error);
+  guess_found_ = tf.guess_from_base.has_value();
+  const std::optional<double> last = odometry_->lastTrackedStamp();
+  if (tf.guess_from_base && last) {
+    ros::Time then;
+    then.fromSec(*last);
+    const std::optional<Eigen::Isometry3d> before = lookup(guess, base, then, 0.0, &error);
+    if (before) {
+      // The base's motion from the last tracked frame to this one, seen from the camera.
+      tf.motion_guess =
+          conjugate(tf.base_from_camera->inverse(), before->inverse() * *tf.guess_from_base);
+    }
+  }
+  if (!tf.guess_from_base || (last && !tf.motion_guess)) {
+    NODELET_WARN_THROTTLE(kGuessWarning,
+                          "no motion guess from '%s' to '%s' at %.6f (%s): the constant-velocity "
+                          "prior is used%s",
+                          guess.c_str(), base.c_str(), stamp.toSec(), error.c_str(),
+                          tf.guess_from_base ? "" : ", and the correction is not published");
+  }
+  return tf;
+}
+
+void OdometryNodelet::publish(const acvo::OdometryResult& r, const std_msgs::Header& header,
+                              const FrameTf& tf) {
+  if (!tf.base_from_camera) return;
+  const Eigen::Isometry3d& base_from_camera = *tf.base_from_camera;
+  const std::string base = baseFrame();
+  std_msgs::Header odom_header;
+  odom_header.stamp = header.stamp;
+  odom_header.frame_id = settings_.odom_frame_id;
+  const bool lost = r.tracking == acvo::Tracking::kLost;
+  if (lost && settings_.lost_odom == LostOdom::kNull) {
+    odom_pub_.publish(nullOdometryMsg(odom_header, base));
+  } else if (!(lost && settings_.lost_odom == LostOdom::kNone)) {
+    odom_pub_.publish(toOdometryMsg(r, base_from_camera, odom_header, base));
+    const Eigen::Isometry3d base_pose = conjugate(base_from_camera, r.pose);
+    if (settings_.publish_tf && settings_.guess_frame_id.empty()) {
       tf_broadcaster_->sendTransform(
-          toTransformMsg(conjugate(*base_from_camera, r.pose), odom_frame_, base, header.stamp));
+          toTransformMsg(base_pose, settings_.odom_frame_id, base, header.stamp));
+    } else if (settings_.publish_tf && tf.guess_from_base) {
+      // odom -> guess -> base: the correction of the guess frame, so that the chain gives the
+      // estimate and the base keeps its one parent (the wheel odometry's frame).
+      tf_broadcaster_->sendTransform(toTransformMsg(base_pose * tf.guess_from_base->inverse(),
+                                                    settings_.odom_frame_id,
+                                                    settings_.guess_frame_id, header.stamp));
     }
   }
   std_msgs::Header cloud_header = header;
-  if (base_is_optical_) cloud_header.frame_id = base;  // the estimated camera, not the sensor's
+  if (settings_.base_is_optical_frame) cloud_header.frame_id = base;  // the estimated camera
   if (r.cloud && cloud_pub_.getNumSubscribers() > 0) {
     cloud_pub_.publish(toPointCloud2(*r.cloud, cloud_header));
   }
@@ -456,9 +501,10 @@ void OdometryNodelet::publish(const acvo::OdometryResult& r, const std_msgs::Hea
 }
 
 void OdometryNodelet::publishInfo(const acvo::OdometryResult& r, const std_msgs::Header& header,
-                                  double ms_total) {
-  last_ms_total_ = ms_total;
-  info_pub_.publish(toInfoMsg(r, header, ms_total, lost_count_));
+                                  const InfoExtras& extras) {
+  last_.ms_total = extras.ms_total;
+  last_.ms_latency = extras.ms_latency;
+  info_pub_.publish(toInfoMsg(r, header, extras));
 }
 
 void OdometryNodelet::restart(const Eigen::Isometry3d& camera_pose) {
@@ -466,10 +512,18 @@ void OdometryNodelet::restart(const Eigen::Isometry3d& camera_pose) {
   published_keyframe_.reset();
 }
 
+void OdometryNodelet::startAt(const Eigen::Isometry3d& base_pose,
+                              const Eigen::Isometry3d& base_from_camera) {
+  // The engine holds the camera pose in the first camera's frame: undo the conjugation.
+  restart(conjugate(base_from_camera.inverse(), base_pose));
+  pending_base_pose_.reset();
+}
+
 bool OdometryNodelet::onReset(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
   try {
     std::lock_guard<std::mutex> lock(mutex_);
     restart(Eigen::Isometry3d::Identity());
+    pending_base_pose_.reset();
     NODELET_INFO("odometry reset to identity");
     return true;
   } catch (const std::exception& e) {
@@ -489,25 +543,24 @@ bool OdometryNodelet::onResetToPose(acvo::ResetToPose::Request& req,
       res.message = problem;
       return true;
     }
-    std::optional<Eigen::Isometry3d> base_from_camera;
-    if (base_is_optical_ || base_frame_param_.empty() || base_frame_param_ == camera_frame_) {
-      base_from_camera = Eigen::Isometry3d::Identity();
-    } else if (!camera_frame_.empty()) {
-      base_from_camera = baseFromCamera();
+    const bool camera_known = !camera_frame_.empty();
+    const std::optional<Eigen::Isometry3d> base_from_camera =
+        camera_known ? baseFromCamera() : std::nullopt;
+    if (base_from_camera) {
+      startAt(base_pose, *base_from_camera);
+      res.message = "odometry restarts from the given pose";
+    } else {
+      // Before the first frame, or before the camera-to-base transform: the next frame whose
+      // transform is known starts there (the frames meanwhile are not published anyway).
+      restart(Eigen::Isometry3d::Identity());
+      pending_base_pose_ = base_pose;
+      res.message = std::string("odometry starts from the given pose at the first frame ") +
+                    (camera_known ? "whose camera-to-base transform ('" + baseFrame() + "' to '" +
+                                        camera_frame_ + "') is known"
+                                  : "(none received yet)");
     }
-    if (!base_from_camera) {
-      res.success = false;
-      res.message = "the camera-to-base transform is not known yet (base frame '" +
-                    base_frame_param_ + "', camera frame '" +
-                    (camera_frame_.empty() ? std::string("none received yet") : camera_frame_) +
-                    "')";
-      return true;
-    }
-    // The engine holds the camera pose in the first camera's frame: undo the conjugation.
-    restart(conjugate(base_from_camera->inverse(), base_pose));
     res.success = true;
-    res.message = "odometry restarts from the given pose";
-    NODELET_INFO("odometry reset to a given pose");
+    NODELET_INFO("reset_odom_to_pose: %s", res.message.c_str());
   } catch (const std::exception& e) {
     res.success = false;
     res.message = e.what();
@@ -515,16 +568,41 @@ bool OdometryNodelet::onResetToPose(acvo::ResetToPose::Request& req,
   return true;
 }
 
+bool OdometryNodelet::onPause(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (paused_) {
+    NODELET_WARN("pause_odom: already paused");
+  } else {
+    paused_ = true;
+    NODELET_INFO("odometry paused: frames are dropped until resume_odom");
+  }
+  return true;
+}
+
+bool OdometryNodelet::onResume(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!paused_) {
+    NODELET_WARN("resume_odom: not paused");
+  } else {
+    paused_ = false;
+    NODELET_INFO(
+        "odometry resumed: the next frame is registered to the last tracked one "
+        "(%lu frames dropped while paused)",
+        static_cast<unsigned long>(count_.paused));
+  }
+  return true;
+}
+
 void OdometryNodelet::onReconfigure(acvo::AcvoConfig& config, uint32_t /*level*/) {
   try {
     std::lock_guard<std::mutex> lock(mutex_);
-    publish_null_when_lost_ = config.publish_null_when_lost;
+    fromString(config.lost_odom, settings_.lost_odom);
     const acvo::Params next = fromConfig(config, params_);
     const std::string invalid = acvo::validate(next);
     if (!invalid.empty()) {
       NODELET_ERROR("dynamic_reconfigure: %s: keeping the previous parameters", invalid.c_str());
       // The server publishes what the callback leaves in `config`: show the values in use.
-      config = toConfig(params_, publish_null_when_lost_);
+      config = toConfig(params_, settings_.lost_odom);
       return;
     }
     if (describeParams(next) == describeParams(params_)) return;
@@ -538,7 +616,7 @@ void OdometryNodelet::onReconfigure(acvo::AcvoConfig& config, uint32_t /*level*/
                  describeParams(params_).c_str());
   } catch (const std::exception& e) {
     NODELET_ERROR("dynamic_reconfigure: %s: keeping the previous parameters", e.what());
-    config = toConfig(params_, publish_null_when_lost_);
+    config = toConfig(params_, settings_.lost_odom);
   }
 }
 
@@ -547,16 +625,16 @@ void OdometryNodelet::onWatchdog(const ros::WallTimerEvent&) {
     updater_->force_update();
     const ros::WallTime now = ros::WallTime::now();
     std::lock_guard<std::mutex> lock(mutex_);
-    const double silent = (now - last_frame_wall_).toSec();
+    const double silent = (now - last_.wall).toSec();
     if (silent > kNoSyncWarning && (now - last_sync_warning_).toSec() > kNoSyncWarning) {
       last_sync_warning_ = now;
       NODELET_WARN(
           "no synchronised frame for %.0f s on %s, %s, %s (messages received so far: %lu, %lu, "
           "%lu)",
-          silent, rgb_sub_.getTopic().c_str(), depth_sub_.getTopic().c_str(),
-          info_sub_.getTopic().c_str(), static_cast<unsigned long>(rgb_count_.load()),
-          static_cast<unsigned long>(depth_count_.load()),
-          static_cast<unsigned long>(info_count_.load()));
+          silent, topics_.rgb.c_str(), topics_.depth.c_str(), topics_.info.c_str(),
+          static_cast<unsigned long>(count_.rgb.load()),
+          static_cast<unsigned long>(count_.depth.load()),
+          static_cast<unsigned long>(count_.info.load()));
     }
   } catch (const std::exception& e) {
     NODELET_ERROR_THROTTLE(10.0, "watchdog: %s", e.what());
@@ -565,19 +643,21 @@ void OdometryNodelet::onWatchdog(const ros::WallTimerEvent&) {
 
 void OdometryNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat) {
   std::lock_guard<std::mutex> lock(mutex_);
-  const double silent = (ros::WallTime::now() - last_frame_wall_).toSec();
+  const double silent = (ros::WallTime::now() - last_.wall).toSec();
   const DiagnosticSummary summary =
-      summarise(synchronised_, silent, no_data_timeout_, last_tracking_);
+      summarise(last_.synchronised, silent, settings_.no_data_timeout, last_.tracking, paused_);
   stat.summary(summary.level, summary.message);
   stat.add("seconds since last frame", silent);
-  stat.add("frames processed", frames_);
-  stat.add("frames lost", lost_count_);
-  stat.add("last tracking", acvo::toString(last_tracking_));
-  stat.add("last message", last_message_);
-  stat.add("last ms total", last_ms_total_);
-  stat.add("messages received (rgb, depth, info)", std::to_string(rgb_count_.load()) + ", " +
-                                                       std::to_string(depth_count_.load()) + ", " +
-                                                       std::to_string(info_count_.load()));
+  stat.add("frames processed", count_.frames);
+  stat.add("frames lost", count_.lost);
+  stat.add("frames dropped while paused", count_.paused);
+  stat.add("last tracking", acvo::toString(last_.tracking));
+  stat.add("last message", last_.message);
+  stat.add("last ms total", last_.ms_total);
+  stat.add("last ms latency", last_.ms_latency);
+  stat.add("messages received (rgb, depth, info)", std::to_string(count_.rgb.load()) + ", " +
+                                                       std::to_string(count_.depth.load()) + ", " +
+                                                       std::to_string(count_.info.load()));
 }
 
 }  // namespace acvo_ros

@@ -103,7 +103,7 @@ std::string describeParams(const acvo::Params& params) {
   return out.str();
 }
 
-acvo::AcvoConfig toConfig(const acvo::Params& params, bool publish_null_when_lost) {
+acvo::AcvoConfig toConfig(const acvo::Params& params, LostOdom lost_odom) {
   acvo::AcvoConfig c = acvo::AcvoConfig::__getDefault__();
   c.target_points = params.selection.target_points;
   c.min_depth = params.selection.min_depth;
@@ -116,7 +116,7 @@ acvo::AcvoConfig toConfig(const acvo::Params& params, bool publish_null_when_los
   c.sparsification = params.solver.sparsification;
   c.max_iterations = params.solver.max_iterations;
   c.initial_guess = acvo::toString(params.odometry.initial_guess);
-  c.publish_null_when_lost = publish_null_when_lost;
+  c.lost_odom = toString(lost_odom);
   return c;
 }
 

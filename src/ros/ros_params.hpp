@@ -12,6 +12,7 @@
 
 #include "acvo/AcvoConfig.h"
 #include "acvo/params.hpp"
+#include "nodelet_settings.hpp"
 
 namespace acvo_ros {
 
@@ -25,7 +26,7 @@ std::vector<std::string> applyRosParams(const XmlRpc::XmlRpcValue& private_ns,
 std::string describeParams(const acvo::Params& params);
 
 // The dynamic_reconfigure view of the parameters it exposes.
-acvo::AcvoConfig toConfig(const acvo::Params& params, bool publish_null_when_lost);
+acvo::AcvoConfig toConfig(const acvo::Params& params, LostOdom lost_odom);
 // The parameters with the reconfigurable ones taken from `config`. Throws
 // std::invalid_argument for an unknown enum string.
 acvo::Params fromConfig(const acvo::AcvoConfig& config, acvo::Params base);

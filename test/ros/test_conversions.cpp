@@ -2,6 +2,7 @@
 // parameter loading, without a ROS master.
 #include <cmath>
 #include <cstring>
+#include <variant>
 
 #include <diagnostic_msgs/DiagnosticStatus.h>
 #include <gtest/gtest.h>
@@ -183,6 +184,39 @@ Eigen::Isometry3d pose(double rx, double ry, double rz, double x, double y, doub
   return t;
 }
 
+TEST(FrameFromMessages, GivesTheFrameOrSaysWhyNotNamingTheTopic) {
+  const InputTopics topics{"/cam/rgb", "/cam/depth", "/cam/info"};
+  sensor_msgs::Image rgb = image(enc::RGB8, 4, 3, 3);
+  rgb.header.frame_id = "/cam_optical";
+  rgb.header.stamp = ros::Time(12, 500000000);
+  sensor_msgs::Image depth = image(enc::TYPE_16UC1, 4, 3, 2);
+  const sensor_msgs::CameraInfo good_info = info(3, 3, 2, 1.5, 4, 3);
+  const auto ok = frameFromMessages(rgb, depth, good_info, {}, topics);
+  ASSERT_TRUE(std::holds_alternative<acvo::Frame>(ok)) << std::get<Rejection>(ok).why;
+  const acvo::Frame& f = std::get<acvo::Frame>(ok);
+  EXPECT_EQ(f.stamp, 12.5);
+  EXPECT_EQ(f.order, acvo::ColorOrder::kRgb);
+  EXPECT_EQ(f.camera.fx, 3.0);
+
+  auto why = [&](const sensor_msgs::Image& c, const sensor_msgs::Image& d,
+                 const sensor_msgs::CameraInfo& i) {
+    const auto r = frameFromMessages(c, d, i, {}, topics);
+    return std::holds_alternative<Rejection>(r) ? std::get<Rejection>(r).why : std::string();
+  };
+  sensor_msgs::Image no_frame = rgb;
+  no_frame.header.frame_id = "/";
+  EXPECT_NE(why(no_frame, depth, good_info).find("no frame_id"), std::string::npos);
+  sensor_msgs::Image bayer = rgb;
+  bayer.encoding = "bayer_rggb8";
+  EXPECT_NE(why(bayer, depth, good_info).find("/cam/rgb"), std::string::npos);
+  sensor_msgs::Image mono16x = depth;
+  mono16x.encoding = "8UC1";
+  EXPECT_NE(why(rgb, mono16x, good_info).find("/cam/depth"), std::string::npos);
+  const sensor_msgs::Image small = image(enc::TYPE_16UC1, 2, 3, 2);
+  EXPECT_NE(why(rgb, small, good_info).find("differ in size"), std::string::npos);
+  EXPECT_NE(why(rgb, depth, info(0, 3, 2, 1.5, 4, 3)).find("/cam/info"), std::string::npos);
+}
+
 TEST(Conjugate, OpticalForwardIsBaseForward) {
   // REP 103 optical frame in a base frame: z_optical = x_base, x_optical = -y_base.
   Eigen::Isometry3d base_from_optical = Eigen::Isometry3d::Identity();
@@ -323,8 +357,8 @@ TEST(RosParams, ReconfigureRoundTripsAndDescribesEveryParameter) {
   p.solver.ell_policy = acvo::EllPolicy::kFixedSchedule;
   p.odometry.initial_guess = acvo::InitialGuess::kIdentity;
   p.solver.sparsification = 1e-3;
-  const acvo::AcvoConfig c = toConfig(p, true);
-  EXPECT_TRUE(c.publish_null_when_lost);
+  const acvo::AcvoConfig c = toConfig(p, LostOdom::kNone);
+  EXPECT_EQ(c.lost_odom, "none");
   const acvo::Params back = fromConfig(c, acvo::Params());
   EXPECT_EQ(describeParams(back), describeParams(p));
   EXPECT_NE(describeParams(p).find("selection/target_points=777"), std::string::npos);
@@ -340,13 +374,13 @@ TEST(RosParams, ReconfigureDefaultsAreTheCoreDefaults) {
   const acvo::Params defaults;
   const acvo::Params from_cfg = fromConfig(acvo::AcvoConfig::__getDefault__(), defaults);
   EXPECT_EQ(describeParams(from_cfg), describeParams(defaults));
-  EXPECT_FALSE(acvo::AcvoConfig::__getDefault__().publish_null_when_lost);
+  EXPECT_EQ(acvo::AcvoConfig::__getDefault__().lost_odom, toString(NodeletSettings().lost_odom));
 }
 
 TEST(RosParams, EveryReconfigureEnumValueIsAcceptedByTheCore) {
   // The .cfg lists the enum strings; they must be the core's own spellings.
   for (const auto& v : {acvo::EllPolicy::kAdaptive, acvo::EllPolicy::kFixedSchedule}) {
-    acvo::AcvoConfig c = toConfig(acvo::Params(), false);
+    acvo::AcvoConfig c = toConfig(acvo::Params(), LostOdom::kHeld);
     c.ell_policy = acvo::toString(v);
     EXPECT_EQ(fromConfig(c, acvo::Params()).solver.ell_policy, v);
   }
@@ -359,6 +393,11 @@ TEST(RosParams, EveryReconfigureEnumValueIsAcceptedByTheCore) {
   for (const char* name : {"constant_velocity", "identity"}) {
     acvo::InitialGuess v;
     EXPECT_NO_THROW(acvo::fromString(name, v)) << name;
+  }
+  for (const char* name : {"held", "null", "none"}) {
+    LostOdom v;
+    EXPECT_NO_THROW(fromString(name, v)) << name;
+    EXPECT_EQ(toString(v), name);
   }
 }
 
@@ -425,7 +464,12 @@ TEST(InfoMsg, CarriesTheResult) {
   r.new_keyframe = true;
   r.fell_back_to_previous = true;
   r.interval = 0.066;
-  const acvo::OdometryInfo info = toInfoMsg(r, {}, 12.5, 3);
+  InfoExtras extras;
+  extras.ms_total = 12.5;
+  extras.ms_latency = 40.25;
+  extras.lost_count = 3;
+  extras.guess_from_tf = true;
+  const acvo::OdometryInfo info = toInfoMsg(r, {}, extras);
   EXPECT_TRUE(info.lost);
   EXPECT_EQ(info.tracking, acvo::toString(acvo::Tracking::kLost));
   EXPECT_EQ(info.iterations, 17);
@@ -433,6 +477,8 @@ TEST(InfoMsg, CarriesTheResult) {
   EXPECT_EQ(info.fixed_points, 1200u);
   EXPECT_EQ(info.moving_points, 30u);
   EXPECT_EQ(info.ms_total, 12.5);
+  EXPECT_EQ(info.ms_latency, 40.25);
+  EXPECT_TRUE(info.guess_from_tf);
   EXPECT_EQ(info.lost_count, 3u);
   EXPECT_EQ(info.message, "too few points");
   EXPECT_EQ(info.frame_index, 41u);
@@ -454,6 +500,25 @@ TEST(Diagnostics, NoDataFirstThenTheLastFramesJudgement) {
   EXPECT_EQ(summarise(true, 0.1, 3.0, acvo::Tracking::kLost).message, "lost");
   EXPECT_EQ(summarise(true, 0.1, 3.0, acvo::Tracking::kBadFrame).message, "bad input");
   EXPECT_EQ(summarise(true, 0.1, 3.0, acvo::Tracking::kBadFrame).level, DiagnosticStatus::ERROR);
+  // Paused says so, whatever came before (no frames come while paused).
+  const DiagnosticSummary paused = summarise(true, 30.0, 3.0, acvo::Tracking::kOk, true);
+  EXPECT_EQ(paused.level, DiagnosticStatus::WARN);
+  EXPECT_EQ(paused.message, "paused");
+}
+
+TEST(NullOdometryMsg, IsRtabmapsLostMessage) {
+  std_msgs::Header h;
+  h.frame_id = "odom";
+  const nav_msgs::Odometry m = nullOdometryMsg(h, "base_link");
+  EXPECT_EQ(m.header.frame_id, "odom");
+  EXPECT_EQ(m.child_frame_id, "base_link");
+  EXPECT_EQ(m.pose.pose.orientation.w, 0.0);
+  EXPECT_EQ(m.pose.pose.orientation.x, 0.0);
+  EXPECT_EQ(m.pose.pose.position.x, 0.0);
+  for (int d = 0; d < 6; ++d) {
+    EXPECT_EQ(m.pose.covariance[7 * d], kLostVariance);
+    EXPECT_EQ(m.twist.covariance[7 * d], kLostVariance);
+  }
 }
 
 }  // namespace

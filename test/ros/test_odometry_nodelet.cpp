@@ -7,7 +7,8 @@
 // .test publishes; empty = base is the optical frame), exact_stamps (run the stamp tests, which
 // need exact synchronisation: the approximate policy itself swallows reordered stamps),
 // late_base_tf (the .test publishes no base transform; the test sends it itself, after checking
-// that nothing is published without it).
+// that nothing is published without it), burst (run the burst test, whose stamps are the wall
+// clock's, on a fresh nodelet), initial_pose (the nodelet's, when the .test sets one).
 #include <cmath>
 #include <map>
 #include <mutex>
@@ -31,6 +32,7 @@
 #include "acvo/params.hpp"
 #include "conversions.hpp"
 #include "covariance.hpp"
+#include "nodelet_settings.hpp"
 #include "synthetic_room.hpp"
 #include "test_messages.hpp"
 
@@ -49,6 +51,11 @@ constexpr double kTranslationPerFrame = 0.004;  // m
 constexpr double kRotationPerFrame = 0.003;     // rad
 constexpr double kExact = 1e-9;
 constexpr double kOutcomeTimeout = 20.0;  // s, one frame through a loaded machine
+// Latency beyond the frames' processing: transport and scheduling on a loaded machine (ms).
+constexpr double kLatencySlack = 100.0;
+// Frames a new one may wait for with topic_queue_size 2: the one in progress, two queued and
+// one in the synchroniser, plus its own processing.
+constexpr double kQueuedFrames = 5.0;
 
 double angleOf(const Eigen::Matrix3d& r) {
   return Eigen::AngleAxisd(r).angle();
@@ -91,6 +98,8 @@ class Client {
     base_frame_ = pnh_.param<std::string>("base_frame", acvo_ros::stripSlash(camera_frame_));
     exact_stamps_ = pnh_.param("exact_stamps", false);
     late_base_tf_ = pnh_.param("late_base_tf", false);
+    burst_ = pnh_.param("burst", false);
+    initial_pose_ = acvo_ros::parsePose6(pnh_.param<std::string>("initial_pose", ""), nullptr);
     base_from_camera_ = Eigen::Isometry3d::Identity();
     std::istringstream tf(pnh_.param<std::string>("base_from_camera", ""));
     double x, y, z, qx, qy, qz, qw;
@@ -130,6 +139,27 @@ class Client {
   }
   // A pause in the stream: the next stamp comes `seconds` later than it would have.
   void skipTime(double seconds) { next_stamp_ += ros::Duration(seconds); }
+
+  // The three messages of a frame, built ahead of publishing (a burst is then quick).
+  struct Messages {
+    sensor_msgs::ImagePtr rgb, depth;
+    sensor_msgs::CameraInfoPtr info;
+  };
+  Messages messages(const RgbdImage& img, const ros::Time& stamp) {
+    std_msgs::Header h;
+    h.stamp = stamp;
+    h.frame_id = camera_frame_;
+    std_msgs::Header dh = h;
+    if (approx_) dh.stamp += ros::Duration(0.007);
+    return {acvo_test::colorMsg(img.rgb, color_encoding_, h),
+            acvo_test::depthMsg(img.depth, depth_encoding_, dh),
+            acvo_test::infoMsg(acvo_test::testCamera(), h)};
+  }
+  void publish(const Messages& m) {
+    info_pub_.publish(m.info);
+    depth_pub_.publish(m.depth);
+    rgb_pub_.publish(m.rgb);
+  }
 
   // Publishes one frame; `mutate` may spoil any of the three messages.
   template <typename Mutate>
@@ -308,6 +338,9 @@ class Client {
   std::string depth_encoding_, color_encoding_, camera_frame_, odom_frame_, base_frame_;
   bool approx_ = true, exact_stamps_ = false;
   bool late_base_tf_ = false;  // the .test publishes no base transform: the test sends it
+  bool burst_ = false;         // a fresh nodelet for the burst test (stamps on the wall clock)
+  // The nodelet's initial_pose, when the .test sets one ("x y z roll pitch yaw").
+  std::optional<Eigen::Isometry3d> initial_pose_;
   Eigen::Isometry3d base_from_camera_;
   ros::Publisher rgb_pub_, depth_pub_, info_pub_;
   ros::Subscriber odom_sub_, info_sub_, diag_sub_, rosout_sub_;
@@ -383,6 +416,47 @@ void expectPoseNear(const geometry_msgs::Pose& got, const Eigen::Isometry3d& wan
   EXPECT_LT(dr, max_r) << what << ": rotation error " << dr << " rad";
   std::cout << "[ MEASURED ] " << what << ": translation error " << dt << " m, rotation error "
             << dr << " rad (" << frames << " frames)\n";
+}
+
+// Runs first (gtest keeps the order of definition): before any frame, the camera frame and its
+// transform to the base are unknown; the pose given is where the first frame starts.
+TEST(OdometryNodelet, AResetToPoseBeforeTheFirstFrameIsWhereItStarts) {
+  if (client->late_base_tf_ || client->initial_pose_) {
+    GTEST_SKIP() << "needs a nodelet that has seen no frame and starts at the origin";
+  }
+  Eigen::Isometry3d given = Eigen::Isometry3d::Identity();
+  given.linear() = Eigen::AngleAxisd(-0.4, Eigen::Vector3d::UnitZ()).matrix();
+  given.translation() << -1.5, 0.25, 0.1;
+  const auto res = client->resetTo(given);
+  ASSERT_TRUE(res);
+  EXPECT_TRUE(res->success) << res->message;
+  std::cout << "[ MEASURED ] reset_odom_to_pose before the first frame: " << res->message << "\n";
+  const std::vector<Outcome> out = client->run(range(0, 4));
+  ASSERT_TRUE(out[0].odom && out.back().odom);
+  EXPECT_EQ(out[0].info->tracking, "first_frame");
+  expectPoseNear(out[0].odom->pose.pose, given, 0, "first frame after an early reset_odom_to_pose");
+  expectPoseNear(out.back().odom->pose.pose, given * client->expectedBase(cameraPose(3)), 3,
+                 "3 frames after an early reset_odom_to_pose");
+}
+
+// initial_pose (nodelet_initial_pose.test): the first frame's pose, and tracking goes on from it.
+TEST(OdometryNodelet, StartsAtTheInitialPose) {
+  if (!client->initial_pose_) GTEST_SKIP() << "needs a .test that sets initial_pose";
+  const std::vector<Outcome> out = client->run(range(0, 4));
+  ASSERT_TRUE(out[0].odom && out.back().odom);
+  EXPECT_EQ(out[0].info->tracking, "first_frame");
+  expectPoseNear(out[0].odom->pose.pose, *client->initial_pose_, 0, "first frame, initial_pose");
+  expectPoseNear(out.back().odom->pose.pose,
+                 *client->initial_pose_ * client->expectedBase(cameraPose(3)), 3,
+                 "3 frames after initial_pose");
+  const auto tf = client->lookup(out.back().odom->header.stamp);
+  ASSERT_TRUE(tf);
+  EXPECT_TRUE(tf2::transformToEigen(*tf).isApprox(toEigen(out.back().odom->pose.pose), 1e-6));
+  // reset_odom goes back to the origin, not to initial_pose (as rtabmap's).
+  ASSERT_TRUE(client->reset());
+  const std::vector<Outcome> again = client->run(range(4, 6));
+  ASSERT_TRUE(again[0].odom);
+  expectPoseNear(again[0].odom->pose.pose, Eigen::Isometry3d::Identity(), 0, "after reset_odom");
 }
 
 TEST(OdometryNodelet, TracksKnownMotionWithRightFramesCovarianceAndTf) {
@@ -527,15 +601,17 @@ TEST(OdometryNodelet, InvalidFramesAreLostThenTrackingResumes) {
       {client->blank(), "no valid depth"},
       {client->farDepth(4), "no valid depth"},
       {client->flatColour(4), "no intensity gradient"}};
+  // One frame in flight at a time (run()): the subscriber queues are short by design.
+  std::vector<RgbdImage> images;
   std::vector<ros::Time> stamps;
   for (const auto& frame : invalid) {
+    images.push_back(frame.first);
     stamps.push_back(client->nextStamp());
-    client->send(frame.first, stamps.back());
   }
-  client->flush();
+  const std::vector<Outcome> outcomes = client->run(images, stamps);
   for (std::size_t i = 0; i < invalid.size(); ++i) {
     SCOPED_TRACE(invalid[i].second);
-    const Outcome o = client->outcome(stamps[i], true);
+    const Outcome& o = outcomes[i];
     ASSERT_TRUE(o.info);
     EXPECT_TRUE(o.info->lost) << o.info->tracking << ": " << o.info->message;
     EXPECT_EQ(o.info->tracking, "lost");
@@ -883,25 +959,155 @@ TEST(OdometryNodelet, ReconfigureRestartsTrackingWithNewParametersAndRefusesBadO
   reconfigure("target_points", 1500, true);
 }
 
-TEST(OdometryNodelet, LostFramesPublishNothingWhenAskedTo) {
+bool setLostOdom(const std::string& value) {
+  dynamic_reconfigure::Reconfigure srv;
+  dynamic_reconfigure::StrParameter p;
+  p.name = "lost_odom";
+  p.value = value;
+  srv.request.config.strs.push_back(p);
+  return ros::service::call("acvo/set_parameters", srv);
+}
+
+// lost_odom: none publishes nothing for a lost frame; null publishes rtabmap's null message (a
+// zero pose, all-zero quaternion, 1e6 variances: publish_null_when_lost there), and no TF.
+TEST(OdometryNodelet, LostFramesPublishNothingOrANullMessageWhenAskedTo) {
   if (client->late_base_tf_) GTEST_SKIP() << "covered by the other configurations";
   ASSERT_TRUE(client->reset());
-  client->run(range(0, 3));
-  dynamic_reconfigure::Reconfigure srv;
-  dynamic_reconfigure::BoolParameter p;
-  p.name = "publish_null_when_lost";
-  p.value = true;
-  srv.request.config.bools.push_back(p);
-  ASSERT_TRUE(ros::service::call("acvo/set_parameters", srv));
+  std::vector<ros::Time> stamps;
+  const std::vector<Outcome> good = client->run(range(0, 3), &stamps);
+  ASSERT_TRUE(good.back().odom);
+
+  ASSERT_TRUE(setLostOdom("none"));
   const ros::Time t = client->nextStamp();
   client->send(client->blank(), t);
   client->flush();
   const Outcome o = client->outcome(t, false);
   ASSERT_TRUE(o.info);
   EXPECT_TRUE(o.info->lost);
-  EXPECT_FALSE(o.odom) << "publish_null_when_lost: nothing is published for a lost frame";
-  srv.request.config.bools[0].value = false;
-  ASSERT_TRUE(ros::service::call("acvo/set_parameters", srv));
+  EXPECT_FALSE(o.odom) << "lost_odom none: nothing is published for a lost frame";
+  EXPECT_FALSE(client->lookup(t)) << "lost_odom none: no TF for a lost frame";
+
+  ASSERT_TRUE(setLostOdom("null"));
+  const ros::Time n = client->nextStamp();
+  client->send(client->blank(), n);
+  client->flush();
+  const Outcome null = client->outcome(n, true);
+  ASSERT_TRUE(null.info);
+  EXPECT_TRUE(null.info->lost);
+  ASSERT_TRUE(null.odom) << "lost_odom null: a null message is published for a lost frame";
+  const auto& q = null.odom->pose.pose.orientation;
+  EXPECT_EQ(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w, 0.0) << "a null pose";
+  EXPECT_EQ(null.odom->pose.pose.position.x, 0.0);
+  EXPECT_EQ(null.odom->child_frame_id, client->base_frame_);
+  for (int d = 0; d < 6; ++d) {
+    EXPECT_EQ(null.odom->pose.covariance[7 * d], acvo_ros::kLostVariance);
+    EXPECT_EQ(null.odom->twist.covariance[7 * d], acvo_ros::kLostVariance);
+  }
+  EXPECT_FALSE(client->lookup(n)) << "lost_odom null: no TF for a lost frame";
+  ASSERT_TRUE(setLostOdom("held"));
+}
+
+bool callEmpty(const std::string& service) {
+  std_srvs::Empty srv;
+  return ros::service::call(service, srv);
+}
+
+// pause_odom: frames are dropped (no odom, no odom_info), diagnostics say "paused";
+// resume_odom: the next frame is registered to the last tracked one and tracking goes on.
+TEST(OdometryNodelet, PauseDropsFramesAndResumeGoesOn) {
+  if (client->late_base_tf_) GTEST_SKIP() << "covered by the other configurations";
+  ASSERT_TRUE(client->reset());
+  const std::vector<Outcome> before = client->run(range(0, 4));
+  ASSERT_TRUE(before.back().odom);
+  ASSERT_TRUE(callEmpty("pause_odom"));
+  std::vector<ros::Time> paused;
+  for (int k = 4; k < 6; ++k) {
+    paused.push_back(client->nextStamp());
+    client->send(client->frame(k), paused.back());
+  }
+  // No flush(): its colour image (frame 0's) would wait in the approximate synchroniser and be
+  // paired with the depth of the first frame after resume_odom. The last paused frame's set is
+  // held there instead, and comes out (whole, after resume_odom) when the next frame arrives.
+  for (const ros::Time& t : paused) {
+    const Outcome o = client->outcome(t, false, 1.0);
+    EXPECT_FALSE(o.info) << "a frame was processed while paused";
+    EXPECT_FALSE(o.odom) << "a frame was published while paused";
+  }
+  const auto diag = client->waitDiagnostic(diagnostic_msgs::DiagnosticStatus::WARN, "paused");
+  ASSERT_TRUE(diag);
+  EXPECT_EQ(diag->message, "paused");
+  ASSERT_TRUE(callEmpty("resume_odom"));
+  const std::vector<Outcome> after = client->run(range(6, 9));
+  for (const Outcome& o : after) {
+    ASSERT_TRUE(o.info && o.odom);
+    EXPECT_TRUE(isTracking(o.info->tracking)) << o.info->tracking << ": " << o.info->message;
+  }
+  // The first frame sent while paused never comes out (the last one may: the approximate
+  // synchroniser holds it until the next frame, sent after resume_odom).
+  EXPECT_EQ(client->infoCount(paused.front()), 0);
+  expectPoseNear(after.back().odom->pose.pose, client->expectedBase(cameraPose(8)), 8,
+                 "3 frames after a pause of 2 frames");
+}
+
+// A camera four times faster than the odometry (a slow machine, a slow frame): the subscriber
+// queues (topic_queue_size 2) keep the newest frames and drop the older ones, so that the
+// latency stays a few frames' processing instead of growing with a backlog, as it did when the
+// subscriber queues were the synchroniser's 10. Stamps are the wall clock's here, so that
+// odom_info.ms_latency is the time from the stamp to publishing.
+TEST(OdometryNodelet, AFasterCameraIsDroppedNotQueued) {
+  if (!client->burst_) GTEST_SKIP() << "needs nodelet_burst.test (a fresh nodelet, exact sync)";
+  // One frame at a time: the time one frame takes, and its latency.
+  std::vector<double> alone_total;
+  for (int k = 0; k < 6; ++k) {
+    const ros::Time t = ros::Time::now();
+    client->send(client->frame(k), t);
+    const Outcome o = client->outcome(t, true);
+    ASSERT_TRUE(o.info && o.odom) << "frame " << k;
+    if (k > 0) alone_total.push_back(o.info->ms_total);  // the first warms the engine up
+    // The latency holds the processing and the transport of the images.
+    EXPECT_GE(o.info->ms_latency, o.info->ms_total);
+    std::cout << "[ MEASURED ] alone, frame " << k << ": ms_total " << o.info->ms_total
+              << ", ms_latency " << o.info->ms_latency << "\n";
+  }
+  std::sort(alone_total.begin(), alone_total.end());
+  const double typical = alone_total[alone_total.size() / 2];
+  const double slowest = alone_total.back();
+  // The stream: kFrames frames at a quarter of the time one typically takes (a load spike
+  // during the frames alone must not make the camera slower than the odometry).
+  constexpr int kFrames = 30;
+  const double period = typical / 4000.0;  // s
+  std::vector<ros::Time> stamps;
+  std::vector<Client::Messages> stream;
+  for (int i = 0; i < kFrames; ++i) client->frame(6 + i);  // rendered ahead
+  const ros::Time start = ros::Time::now() + ros::Duration(0.5);
+  for (int i = 0; i < kFrames; ++i) {
+    stamps.push_back(start + ros::Duration(period * i));
+    stream.push_back(client->messages(client->frame(6 + i), stamps.back()));
+  }
+  for (int i = 0; i < kFrames; ++i) {
+    const ros::Duration wait = stamps[i] - ros::Time::now();
+    if (wait > ros::Duration(0)) wait.sleep();
+    client->publish(stream[i]);
+  }
+  // The last frame comes out: everything before it is done then.
+  const Outcome last = client->outcome(stamps.back(), true);
+  ASSERT_TRUE(last.info && last.odom) << "the newest frame must be processed";
+  std::vector<double> latency;
+  for (const ros::Time& t : stamps) {
+    const Outcome o = client->outcome(t, false, 0.01);
+    if (o.info) latency.push_back(o.info->ms_latency);
+  }
+  const double worst = *std::max_element(latency.begin(), latency.end());
+  std::cout << "[ MEASURED ] " << kFrames << " frames every " << period * 1000.0
+            << " ms (one takes " << typical << " ms alone, up to " << slowest
+            << " ms): " << latency.size() << " processed; latency first " << latency.front()
+            << " ms, last " << latency.back() << " ms, worst " << worst << " ms\n";
+  // A backlog processes every frame it holds, each later than the one before. Measured: with
+  // the queues of 2, 9 of 30 processed, worst latency 110-123 ms (three runs); with 10 per
+  // topic (as before) 16-21 processed and 455-475 ms.
+  EXPECT_LE(latency.size(), std::size_t{kFrames * 2 / 5});
+  EXPECT_LT(worst, kQueuedFrames * slowest + kLatencySlack);
+  EXPECT_TRUE(isTracking(last.info->tracking)) << last.info->message;
 }
 
 TEST(OdometryNodelet, MissingBaseTransformIsReportedNotReplacedByIdentity) {
