@@ -95,7 +95,9 @@ void checkAgainstAcvo(const Fused& f, const std::string& variant) {
   EXPECT_TRUE(pose || twist) << "nothing of acvo is fused";
   EXPECT_FALSE(pose && twist) << "pose and twist of one odometry are the same information";
   // acvo's pose drifts from its own origin: fused as differences only.
-  if (pose) EXPECT_TRUE(f.differential) << "acvo's pose must be fused with differential: true";
+  if (pose) {
+    EXPECT_TRUE(f.differential) << "acvo's pose must be fused with differential: true";
+  }
 
   constexpr int kTracked = 5, kLost = 5;
   const std::vector<nav_msgs::Odometry> msgs = acvoMessages(kTracked, kLost);
