@@ -387,15 +387,15 @@ TEST(RosParams, EveryReconfigureEnumValueIsAcceptedByTheCore) {
   acvo::AcvoConfig c = acvo::AcvoConfig::__getDefault__();
   EXPECT_NO_THROW(fromConfig(c, acvo::Params()));
   for (const char* name : {"adaptive", "fixed_schedule"}) {
-    acvo::EllPolicy v;
+    acvo::EllPolicy v{};
     EXPECT_NO_THROW(acvo::fromString(name, v)) << name;
   }
   for (const char* name : {"constant_velocity", "identity"}) {
-    acvo::InitialGuess v;
+    acvo::InitialGuess v{};
     EXPECT_NO_THROW(acvo::fromString(name, v)) << name;
   }
   for (const char* name : {"held", "null", "none"}) {
-    LostOdom v;
+    LostOdom v{};
     EXPECT_NO_THROW(fromString(name, v)) << name;
     EXPECT_EQ(toString(v), name);
   }
