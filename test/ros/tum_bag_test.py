@@ -115,8 +115,9 @@ class TumBagTest(unittest.TestCase):
                                  "rgb8" if topic.endswith("image_color") else "32FC1")
                 self.assertTrue(msg.header.frame_id.startswith("/openni_"))
 
-        # As the README's recipe runs it: from a shell in the bag's folder, with relative bag and
-        # record paths, which must be taken from there (roslaunch starts its nodes in ~/.ros).
+        # As the recipe (README, docs/ros.md) runs it: from a shell in the bag's folder, with
+        # relative bag and record paths, which must be taken from there (roslaunch starts its
+        # nodes in ~/.ros).
         # A queue large enough for the whole bag: a slow machine processes every frame, late.
         launch = subprocess.run(
             ["bash", "-c", 'cd "$0" && exec roslaunch "$@"', work, "acvo", "tum_bag.launch",

@@ -1,7 +1,7 @@
 // Whole sequences: RPE over 1 s on synthetic 300-frame sequences (Kinect-like noise) in the
 // TUM structure/texture conditions and on the shared real Kinect frames, for the default engine
 // (coarse_to_fine) and the paper's two policies (paperParams()). Bounds are the measured
-// figures with a margin (README, "Accuracy").
+// figures with a margin (docs/accuracy.md).
 #include <algorithm>
 #include <array>
 #include <cmath>
