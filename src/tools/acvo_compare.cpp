@@ -1,10 +1,15 @@
 // acvo_compare: acvo against OpenCV contrib's RGB-D odometries (RgbdOdometry, ICPOdometry,
-// RgbdICPOdometry) on TUM-format folders, the same frames in the same run: RPE over 1 s, ATE,
-// lost frames and time per frame, as one table (and JSON).
+// RgbdICPOdometry) on TUM-format folders: RPE over 1 s, ATE, lost frames and time per frame, as
+// one table (and JSON).
 //
-// The peers run as a user would run them: OpenCV's default parameters, the dataset's
-// intrinsics, depth in metres, the previous frame's motion as the initial guess, and each
-// frame's pyramids built once and reused when it becomes the previous frame.
+// Fair by construction: the peers run as OpenCV's own TUM sample runs them (peers.hpp: NaN holes,
+// compute(current, previous)) at every maximum depth given, with the best setting named; acvo
+// runs on as many threads as asked (one by default: the peers are serial) and its CPU time is
+// shown; every frame goes to every method in turn (the order rotating), so that a machine that
+// slows down or speeds up during the run does so for all of them; --repeat gives the median of
+// the per-run medians and their spread.
+#include <time.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -16,19 +21,16 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
-#include <opencv2/core/eigen.hpp>  // after Eigen's headers
-#include <opencv2/imgproc.hpp>
-#include <opencv2/rgbd.hpp>
 
 #include "acvo/evaluation.hpp"
 #include "acvo/odometry.hpp"
 #include "acvo/params.hpp"
 #include "acvo/tum.hpp"
+#include "peers.hpp"
 #include "tool_support.hpp"
 
 namespace {
@@ -36,18 +38,26 @@ namespace {
 constexpr const char* kDescription =
     R"(Runs acvo and OpenCV contrib's RgbdOdometry, ICPOdometry and RgbdICPOdometry over TUM RGB-D
 folders (rgb.txt, depth.txt, associations.txt, groundtruth.txt, camera.yaml) and prints one
-table: RPE over 1 s (translation m/s, rotation deg/s), ATE (m), lost frames, median and 90th
-percentile milliseconds per frame, and the median time as a ratio of RgbdOdometry's.
-Every method sees the same decoded frames; times cover the odometry call only (acvo: cloud
-building and registration; OpenCV: grey conversion, pyramids and registration).
+table: RPE over 1 s (translation m/s, rotation deg/s), ATE (m), lost frames, median time per
+frame (wall and CPU) and the median time as a ratio of the best RgbdOdometry setting's.
+The OpenCV odometries run as OpenCV's TUM sample runs them (missing depth as NaN, the current
+frame registered to the previous one, no initial guess), once per --peer-max-depth; the
+<peer>_best row repeats the setting with the lowest errors (translation and rotation, each
+relative to the settings' mean). Every method sees the same decoded frames, frame by frame in
+turn; times cover the odometry call only (acvo: cloud building and registration; OpenCV: grey
+conversion, hole marking, pyramids and registration).
 )";
 
 constexpr const char* kFooter = "Exit status: 0 success, 2 bad arguments or input.";
 
 struct Options {
   std::vector<std::string> datasets, methods{"acvo", "rgbd", "icp", "rgbd_icp"}, sets;
+  std::vector<double> peer_max_depth{4.0, 10.0};
+  std::vector<int> threads{1};
   std::string config, label = "acvo", json, trajectories;
   long frames = -1;
+  int repeat = 1;
+  bool peer_guess = false;
 };
 
 // The command line into `o`; nullopt to go on, else the exit status.
@@ -60,6 +70,29 @@ std::optional<int> parseOptions(CLI::App& app, Options& o, int argc, char** argv
       ->allow_extra_args(false)
       ->default_str("all")
       ->check(CLI::IsMember({"acvo", "rgbd", "icp", "rgbd_icp"}).description(""));
+  app.add_option("--peer-max-depth", o.peer_max_depth,
+                 "the OpenCV odometries' maximum depth (m), one row per value")
+      ->type_name("LIST")
+      ->delimiter(',')
+      ->allow_extra_args(false)
+      ->default_str("4,10")
+      ->check(acvo::tools::numberIn(1e-3, 1e3, "within [0.001, 1000]"));
+  app.add_option("--threads", o.threads,
+                 "acvo's worker threads, one row per value (0 = every core); 1 by default, as "
+                 "the OpenCV odometries are serial")
+      ->type_name("LIST")
+      ->delimiter(',')
+      ->allow_extra_args(false)
+      ->default_str("1")
+      ->check(acvo::tools::numberIn(0, 1024, "within [0, 1024]"));
+  app.add_option("--repeat", o.repeat,
+                 "run everything N times: times are the median of the runs' medians")
+      ->type_name("N")
+      ->capture_default_str()
+      ->check(acvo::tools::numberIn(1, 1000, "within [1, 1000]"));
+  app.add_flag("--peer-guess", o.peer_guess,
+               "give the OpenCV odometries the last motion as the initial guess (OpenCV's "
+               "sample gives none)");
   app.add_option("--config", o.config, "acvo parameters (default: built in, as config/acvo.yaml)")
       ->type_name("FILE");
   app.add_option("--set", o.sets, "override one acvo parameter (repeatable)")
@@ -74,84 +107,77 @@ std::optional<int> parseOptions(CLI::App& app, Options& o, int argc, char** argv
           acvo::tools::numberIn(0L, std::numeric_limits<long>::max(), "a non-negative integer"));
   app.add_option("--json", o.json, "write every figure as JSON")->type_name("FILE");
   app.add_option("--trajectories", o.trajectories,
-                 "write each estimate as DIR/<dataset>-<method>.txt")
+                 "write each estimate as DIR/<dataset>-<method>[-<setting>].txt")
       ->type_name("DIR");
   if (const auto status = acvo::tools::parseCommandLine(app, argc, argv)) return status;
   // --methods "" or ",": CLI11 leaves the list empty.
   if (o.methods.empty()) return acvo::tools::usageError(app, "--methods is empty");
+  if (o.peer_max_depth.empty()) return acvo::tools::usageError(app, "--peer-max-depth is empty");
+  if (o.threads.empty()) return acvo::tools::usageError(app, "--threads is empty");
   return std::nullopt;
 }
 
-// One method's run over one dataset.
-struct Run {
-  std::string dataset, method;
+// One row of the table: a method at one setting over one dataset.
+struct Row {
+  std::string dataset, method, setting;
+  bool best = false;  // a <peer>_best row
   acvo::Trajectory trajectory;
-  std::vector<double> ms;  // per registered frame
   long lost = 0;
   double rpe_trans = NAN, rpe_rot = NAN, ate = NAN;
+  // Per run: the median and 90th percentile over frames of the wall and CPU times (ms), and
+  // the median as a ratio of the best RgbdOdometry row's median in that run.
+  std::vector<double> median_ms, p90_ms, cpu_median_ms, ratio;
 };
 
-// A frame-to-frame odometry: returns false when the frame is lost; `pose` is the camera pose.
-using Step = std::function<bool(const acvo::Frame&, Eigen::Isometry3d& pose)>;
+Row makeRow(const std::string& dataset, const std::string& method, const std::string& setting) {
+  Row row;
+  row.dataset = dataset;
+  row.method = method;
+  row.setting = setting;
+  return row;
+}
 
-Step acvoStep(const acvo::Params& params, const Eigen::Isometry3d& start) {
-  auto odometry = std::make_shared<acvo::Odometry>(params);
-  odometry->reset(start);
-  return [odometry](const acvo::Frame& f, Eigen::Isometry3d& pose) {
-    const acvo::OdometryResult r = odometry->process(f);
-    pose = r.pose;
+// A method that registers frames one after the other: process() returns false when the frame
+// is lost; pose() is the camera pose after it.
+class Method {
+ public:
+  virtual ~Method() = default;
+  virtual bool process(const acvo::Frame& frame) = 0;
+  virtual const Eigen::Isometry3d& pose() const = 0;
+};
+
+class AcvoMethod : public Method {
+ public:
+  AcvoMethod(const acvo::Params& params, const Eigen::Isometry3d& start) : odometry_(params) {
+    odometry_.reset(start);
+  }
+  bool process(const acvo::Frame& frame) override {
+    const acvo::OdometryResult r = odometry_.process(frame);
     return r.tracking != acvo::Tracking::kLost && r.tracking != acvo::Tracking::kBadFrame;
-  };
-}
+  }
+  const Eigen::Isometry3d& pose() const override { return odometry_.pose(); }
 
-cv::Ptr<cv::rgbd::Odometry> makePeer(const std::string& method, const acvo::Camera& c) {
-  const cv::Mat K = (cv::Mat_<float>(3, 3) << c.fx, 0, c.cx, 0, c.fy, c.cy, 0, 0, 1);
-  if (method == "rgbd") return cv::rgbd::RgbdOdometry::create(K);
-  if (method == "icp") return cv::rgbd::ICPOdometry::create(K);
-  return cv::rgbd::RgbdICPOdometry::create(K);
-}
+ private:
+  acvo::Odometry odometry_;
+};
 
-// OpenCV's odometry: compute(src = previous, dst = current) gives Rt with dst_p = Rt src_p,
-// so the current camera's pose is pose_prev * Rt^-1; the previous Rt is the guess.
-Step peerStep(const std::string& method, const acvo::Camera& camera,
-              const Eigen::Isometry3d& start) {
-  struct State {
-    cv::Ptr<cv::rgbd::Odometry> odometry;
-    cv::Ptr<cv::rgbd::OdometryFrame> previous;
-    cv::Mat guess = cv::Mat::eye(4, 4, CV_64FC1);
-    Eigen::Isometry3d pose;
-  };
-  auto s = std::make_shared<State>();
-  s->odometry = makePeer(method, camera);
-  s->pose = start;
-  return [s](const acvo::Frame& f, Eigen::Isometry3d& pose) {
-    cv::Mat grey;
-    const int code = f.order == acvo::ColorOrder::kRgb ? cv::COLOR_RGB2GRAY : cv::COLOR_BGR2GRAY;
-    if (f.order == acvo::ColorOrder::kGray) {
-      grey = f.color;
-    } else {
-      cv::cvtColor(f.color, grey, code);
-    }
-    cv::Ptr<cv::rgbd::OdometryFrame> current = cv::rgbd::OdometryFrame::create(grey, f.depth);
-    bool ok = true;
-    if (s->previous) {
-      cv::Mat Rt;
-      ok = s->odometry->compute(s->previous, current, Rt, s->guess);
-      if (ok && !Rt.empty()) {
-        Eigen::Matrix4d m;
-        cv::cv2eigen(Rt, m);
-        s->pose = s->pose * Eigen::Isometry3d(m).inverse();
-        s->guess = Rt;
-      } else {
-        ok = false;
-        s->guess = cv::Mat::eye(4, 4, CV_64FC1);
-      }
-    }
-    s->previous = current;
-    pose = s->pose;
-    return ok;
-  };
-}
+class PeerMethod : public Method {
+ public:
+  PeerMethod(const acvo::peers::PeerSetup& setup, const acvo::Camera& camera,
+             const Eigen::Isometry3d& start)
+      : peer_(setup, camera, start) {}
+  bool process(const acvo::Frame& frame) override { return peer_.process(frame); }
+  const Eigen::Isometry3d& pose() const override { return peer_.pose(); }
+
+ private:
+  acvo::peers::PeerOdometry peer_;
+};
+
+// What one row runs: its row and how to make a fresh method for each run.
+struct Entry {
+  Row row;
+  std::function<std::unique_ptr<Method>()> make;
+};
 
 // The first pose: the ground truth nearest the first frame, identity without one.
 Eigen::Isometry3d startPose(const acvo::TumDataset& data, double stamp) {
@@ -166,11 +192,195 @@ std::string baseName(std::string path) {
   return slash == std::string::npos ? path : path.substr(slash + 1);
 }
 
+std::string threadsSetting(int threads) {
+  if (threads == 0) return "all_cores";
+  return std::to_string(threads) + (threads == 1 ? "_thread" : "_threads");
+}
+
+std::string depthSetting(double max_depth) {
+  std::ostringstream s;
+  s << max_depth << "m";
+  return s.str();
+}
+
+// The rows of one dataset: acvo once per thread count, each peer once per maximum depth.
+std::vector<Entry> entriesFor(const Options& opt, const acvo::Params& params,
+                              const acvo::TumDataset& data, const std::string& dataset,
+                              const Eigen::Isometry3d& start) {
+  std::vector<Entry> entries;
+  for (const auto& method : opt.methods) {
+    if (method == "acvo") {
+      for (int threads : opt.threads) {
+        acvo::Params p = params;
+        p.odometry.threads = threads;
+        entries.push_back({makeRow(dataset, opt.label, threadsSetting(threads)),
+                           [p, start] { return std::make_unique<AcvoMethod>(p, start); }});
+      }
+      continue;
+    }
+    for (double max_depth : opt.peer_max_depth) {
+      acvo::peers::PeerSetup setup;
+      setup.kind = acvo::peers::parsePeerKind(method);
+      setup.max_depth = max_depth;
+      setup.previous_motion_guess = opt.peer_guess;
+      const acvo::Camera camera = data.camera();
+      entries.push_back({makeRow(dataset, method, depthSetting(max_depth)), [setup, camera, start] {
+                           return std::make_unique<PeerMethod>(setup, camera, start);
+                         }});
+    }
+  }
+  return entries;
+}
+
+double processCpuMs() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return 1e3 * double(t.tv_sec) + 1e-6 * double(t.tv_nsec);
+}
+
+// One run over the frames: every frame to every method in turn, the first method of each frame
+// rotating. The first run also records the trajectories.
+void runOnce(std::vector<Entry>& entries, const std::vector<acvo::Frame>& frames,
+             const acvo::TumDataset& data, bool record) {
+  const std::size_t m = entries.size();
+  std::vector<std::unique_ptr<Method>> methods;
+  for (auto& e : entries) methods.push_back(e.make());
+  std::vector<std::vector<double>> wall(m), cpu(m);
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    for (std::size_t k = 0; k < m; ++k) {
+      const std::size_t j = (i + k) % m;
+      const double cpu0 = processCpuMs();
+      const auto t0 = std::chrono::steady_clock::now();
+      const bool ok = methods[j]->process(frames[i]);
+      const double ms =
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+      const double cpu_ms = processCpuMs() - cpu0;
+      if (i > 0) {  // the first frame only starts the sequence
+        wall[j].push_back(ms);
+        cpu[j].push_back(cpu_ms);
+      }
+      if (!record) continue;
+      Row& row = entries[j].row;
+      if (!ok && i > 0) ++row.lost;
+      const auto& stamp = data.frames()[i].rgb;
+      row.trajectory.push_back({stamp.stamp_text, stamp.stamp, methods[j]->pose()});
+    }
+  }
+  for (std::size_t j = 0; j < m; ++j) {
+    Row& row = entries[j].row;
+    row.median_ms.push_back(acvo::tools::percentile(wall[j], 0.5));
+    row.p90_ms.push_back(acvo::tools::percentile(wall[j], 0.9));
+    row.cpu_median_ms.push_back(acvo::tools::percentile(cpu[j], 0.5));
+  }
+}
+
+void evaluate(Row& row, const acvo::TumDataset& data) {
+  if (!data.groundtruth()) return;
+  try {
+    const acvo::RpeResult rpe = acvo::computeRpe(*data.groundtruth(), row.trajectory);
+    row.rpe_trans = rpe.trans.rmse;
+    row.rpe_rot = rpe.rot_deg.rmse;
+    row.ate = acvo::computeAte(*data.groundtruth(), row.trajectory).trans.rmse;
+  } catch (const std::exception& e) {
+    std::cerr << "acvo_compare: " << row.dataset << " " << row.method << " " << row.setting
+              << ": no evaluation: " << e.what() << "\n";
+  }
+}
+
+// Per OpenCV odometry, the index of its best row: the fewest lost frames, then the lowest sum
+// of the translation and rotation errors, each divided by its mean over the settings.
+std::map<std::string, std::size_t> bestRows(const std::vector<Entry>& entries,
+                                            const std::string& acvo_label) {
+  std::map<std::string, std::vector<std::size_t>> by_method;
+  for (std::size_t k = 0; k < entries.size(); ++k) {
+    if (entries[k].row.method != acvo_label) by_method[entries[k].row.method].push_back(k);
+  }
+  std::map<std::string, std::size_t> best;
+  for (const auto& [method, rows] : by_method) {
+    double mean_t = 0.0, mean_r = 0.0;
+    for (std::size_t k : rows) {
+      mean_t += entries[k].row.rpe_trans / double(rows.size());
+      mean_r += entries[k].row.rpe_rot / double(rows.size());
+    }
+    const auto worse = [&](std::size_t a, std::size_t b) {  // a is worse than b
+      const Row &ra = entries[a].row, &rb = entries[b].row;
+      if (ra.lost != rb.lost) return ra.lost > rb.lost;
+      const double sa = ra.rpe_trans / mean_t + ra.rpe_rot / mean_r;
+      const double sb = rb.rpe_trans / mean_t + rb.rpe_rot / mean_r;
+      return !(sa <= sb) && std::isfinite(sb);  // NaN (no ground truth) is never better
+    };
+    std::size_t chosen = rows.front();
+    for (std::size_t k : rows) {
+      if (worse(chosen, k)) chosen = k;
+    }
+    best[method] = chosen;
+  }
+  return best;
+}
+
+double median(std::vector<double> v) { return acvo::tools::percentile(std::move(v), 0.5); }
+
+// (max - min) / median of the runs' values, in percent; 0 for a single run.
+double spreadPercent(const std::vector<double>& v) {
+  if (v.size() < 2) return 0.0;
+  const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
+  const double m = median(v);
+  return m > 0.0 ? 100.0 * (*hi - *lo) / m : NAN;
+}
+
 std::string jsonNumber(double v) {
   if (!std::isfinite(v)) return "null";
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.6g", v);
   return buf;
+}
+
+std::string jsonList(const std::vector<double>& v) {
+  std::string s = "[";
+  for (std::size_t k = 0; k < v.size(); ++k) s += (k ? ", " : "") + jsonNumber(v[k]);
+  return s + "]";
+}
+
+void printTable(const std::vector<Row>& rows, const Options& opt) {
+  std::string threads;
+  for (int t : opt.threads) threads += (threads.empty() ? "" : ",") + threadsSetting(t);
+  std::printf("# acvo on %s; OpenCV odometries serial, as OpenCV's TUM sample runs them (NaN "
+              "holes, no guess); times: median over frames, median of %d run%s interleaved "
+              "frame by frame; vs_rgbd: median time / the best RgbdOdometry setting's, per run\n",
+              threads.c_str(), opt.repeat, opt.repeat == 1 ? "" : "s");
+  std::printf("%-20s %-12s %-12s %10s %11s %8s %5s %9s %8s %8s %8s\n", "dataset", "method",
+              "setting", "rpe_t_m/s", "rpe_r_deg/s", "ate_m", "lost", "median_ms", "cpu_ms",
+              "spread_%", "vs_rgbd");
+  for (const auto& r : rows) {
+    std::printf("%-20s %-12s %-12s %10.4f %11.3f %8.4f %5ld %9.2f %8.2f %8.1f %8.2f\n",
+                r.dataset.c_str(), r.method.c_str(), r.setting.c_str(), r.rpe_trans, r.rpe_rot,
+                r.ate, r.lost, median(r.median_ms), median(r.cpu_median_ms),
+                spreadPercent(r.median_ms), median(r.ratio));
+  }
+}
+
+void writeJson(const std::vector<Row>& rows, const Options& opt) {
+  std::ofstream out(opt.json);
+  if (!out) throw std::runtime_error("cannot write " + opt.json);
+  out << "{\"rpe_delta_s\": 1, \"repeat\": " << opt.repeat << ", \"acvo_threads\": [";
+  for (std::size_t k = 0; k < opt.threads.size(); ++k) out << (k ? ", " : "") << opt.threads[k];
+  out << "], \"runs\": [";
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    const Row& r = rows[k];
+    out << (k ? ",\n  " : "\n  ") << "{\"dataset\": \"" << r.dataset << "\", \"method\": \""
+        << r.method << "\", \"setting\": \"" << r.setting
+        << "\", \"best\": " << (r.best ? "true" : "false")
+        << ", \"frames\": " << r.trajectory.size() << ", \"rpe_trans\": " << jsonNumber(r.rpe_trans)
+        << ", \"rpe_rot_deg\": " << jsonNumber(r.rpe_rot) << ", \"ate\": " << jsonNumber(r.ate)
+        << ", \"lost\": " << r.lost << ", \"median_ms\": " << jsonNumber(median(r.median_ms))
+        << ", \"p90_ms\": " << jsonNumber(median(r.p90_ms))
+        << ", \"cpu_median_ms\": " << jsonNumber(median(r.cpu_median_ms))
+        << ", \"median_ms_runs\": " << jsonList(r.median_ms)
+        << ", \"spread_percent\": " << jsonNumber(spreadPercent(r.median_ms))
+        << ", \"median_vs_rgbd\": " << jsonNumber(median(r.ratio))
+        << ", \"vs_rgbd_runs\": " << jsonList(r.ratio) << "}";
+  }
+  out << "\n]}\n";
 }
 
 }  // namespace
@@ -186,7 +396,7 @@ int main(int argc, char** argv) {
     } catch (const std::exception& e) {  // a malformed --set, an unknown key, a bad config
       return acvo::tools::usageError(app, e.what());
     }
-    std::vector<Run> runs;
+    std::vector<Row> rows;
     for (const auto& folder : opt.datasets) {
       const acvo::TumDataset data(folder);
       const std::size_t n =
@@ -195,77 +405,47 @@ int main(int argc, char** argv) {
       frames.reserve(n);
       for (std::size_t i = 0; i < n; ++i) frames.push_back(data.loadFrame(i));
       if (frames.empty()) throw std::runtime_error(folder + ": no frames");
-      const Eigen::Isometry3d start = startPose(data, frames.front().stamp);
-      for (const auto& method : opt.methods) {
-        Run run{baseName(folder), method == "acvo" ? opt.label : method, {}, {}, 0};
-        Step step =
-            method == "acvo" ? acvoStep(params, start) : peerStep(method, data.camera(), start);
-        for (std::size_t i = 0; i < n; ++i) {
-          Eigen::Isometry3d pose;
-          const auto t0 = std::chrono::steady_clock::now();
-          const bool ok = step(frames[i], pose);
-          const double ms =
-              std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
-                  .count();
-          if (i > 0) run.ms.push_back(ms);
-          if (!ok && i > 0) ++run.lost;
-          const auto& entry = data.frames()[i].rgb;
-          run.trajectory.push_back({entry.stamp_text, entry.stamp, pose});
-        }
-        if (data.groundtruth()) {
-          try {
-            const acvo::RpeResult rpe = acvo::computeRpe(*data.groundtruth(), run.trajectory);
-            run.rpe_trans = rpe.trans.rmse;
-            run.rpe_rot = rpe.rot_deg.rmse;
-            run.ate = acvo::computeAte(*data.groundtruth(), run.trajectory).trans.rmse;
-          } catch (const std::exception& e) {
-            std::cerr << "acvo_compare: " << run.dataset << " " << run.method
-                      << ": no evaluation: " << e.what() << "\n";
-          }
-        }
-        if (!opt.trajectories.empty()) {
-          acvo::writeTrajectory(opt.trajectories + "/" + run.dataset + "-" + run.method + ".txt",
-                                run.trajectory, run.method + " on " + folder);
-        }
-        runs.push_back(std::move(run));
-      }
-    }
+      const std::string dataset = baseName(folder);
+      std::vector<Entry> entries =
+          entriesFor(opt, params, data, dataset, startPose(data, frames.front().stamp));
+      for (int run = 0; run < opt.repeat; ++run) runOnce(entries, frames, data, run == 0);
+      for (auto& e : entries) evaluate(e.row, data);
 
-    // Speed as a ratio of RgbdOdometry's median on the same dataset in this run.
-    std::map<std::string, double> rgbd_median;
-    for (const auto& r : runs) {
-      if (r.method == "rgbd") rgbd_median[r.dataset] = acvo::tools::percentile(r.ms, 0.5);
-    }
-    std::printf("%-20s %-10s %10s %10s %8s %5s %9s %8s %8s\n", "dataset", "method", "rpe_t_m/s",
-                "rpe_r_deg/s", "ate_m", "lost", "median_ms", "p90_ms", "vs_rgbd");
-    for (const auto& r : runs) {
-      const double median = acvo::tools::percentile(r.ms, 0.5);
-      const auto it = rgbd_median.find(r.dataset);
-      const double ratio = it != rgbd_median.end() && it->second > 0 ? median / it->second : NAN;
-      std::printf("%-20s %-10s %10.4f %10.3f %8.4f %5ld %9.2f %8.2f %8.2f\n", r.dataset.c_str(),
-                  r.method.c_str(), r.rpe_trans, r.rpe_rot, r.ate, r.lost, median,
-                  acvo::tools::percentile(r.ms, 0.9), ratio);
-    }
-    if (!opt.json.empty()) {
-      std::ofstream out(opt.json);
-      if (!out) throw std::runtime_error("cannot write " + opt.json);
-      out << "{\"rpe_delta_s\": 1, \"runs\": [";
-      for (std::size_t k = 0; k < runs.size(); ++k) {
-        const Run& r = runs[k];
-        const double median = acvo::tools::percentile(r.ms, 0.5);
-        const auto it = rgbd_median.find(r.dataset);
-        out << (k ? ",\n  " : "\n  ") << "{\"dataset\": \"" << r.dataset << "\", \"method\": \""
-            << r.method << "\", \"frames\": " << r.trajectory.size()
-            << ", \"rpe_trans\": " << jsonNumber(r.rpe_trans)
-            << ", \"rpe_rot_deg\": " << jsonNumber(r.rpe_rot) << ", \"ate\": " << jsonNumber(r.ate)
-            << ", \"lost\": " << r.lost << ", \"median_ms\": " << jsonNumber(median)
-            << ", \"p90_ms\": " << jsonNumber(acvo::tools::percentile(r.ms, 0.9))
-            << ", \"median_vs_rgbd\": "
-            << jsonNumber(it != rgbd_median.end() && it->second > 0 ? median / it->second : NAN)
-            << "}";
+      // The best setting of each peer, and the speed ratio to the best RgbdOdometry, per run.
+      const auto best = bestRows(entries, opt.label);
+      const auto rgbd = best.find("rgbd");
+      for (auto& e : entries) {
+        for (int run = 0; run < opt.repeat; ++run) {
+          e.row.ratio.push_back(rgbd == best.end()
+                                    ? NAN
+                                    : e.row.median_ms[std::size_t(run)] /
+                                          entries[rgbd->second].row.median_ms[std::size_t(run)]);
+        }
       }
-      out << "\n]}\n";
+      for (std::size_t k = 0; k < entries.size(); ++k) {
+        Row& row = entries[k].row;
+        if (!opt.trajectories.empty()) {
+          const bool plain = row.method == opt.label && opt.threads.size() == 1;
+          acvo::writeTrajectory(
+              opt.trajectories + "/" + dataset + "-" + row.method +
+                  (plain ? "" : "-" + row.setting) + ".txt",
+              row.trajectory, row.method + " " + row.setting + " on " + folder);
+        }
+        rows.push_back(row);
+        // After a peer's last setting, its best one again, named as such.
+        const bool last_of_method =
+            k + 1 == entries.size() || entries[k + 1].row.method != row.method;
+        const auto b = best.find(row.method);
+        if (last_of_method && b != best.end() && opt.peer_max_depth.size() > 1) {
+          Row best_row = entries[b->second].row;
+          best_row.method += "_best";
+          best_row.best = true;
+          rows.push_back(std::move(best_row));
+        }
+      }
     }
+    printTable(rows, opt);
+    if (!opt.json.empty()) writeJson(rows, opt);
     return 0;
   } catch (const std::exception& e) {
     std::cerr << "acvo_compare: " << e.what() << "\n";

@@ -1,5 +1,7 @@
-// acvo_compare end to end on a small synthetic sequence: the table's columns and rows, the
-// speed ratio's reference row, the JSON beside it, and the errors for bad arguments.
+// acvo_compare end to end on a small synthetic sequence: the table's columns and rows (a row
+// per method and setting, the best peer setting named), the speed ratio's reference row, the
+// JSON beside it, threads and repeats, and the errors for bad arguments. Whether the peers are
+// set up right is test_peers' question.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -25,10 +27,12 @@ int runTool(const std::string& tool, const std::string& arguments, const fs::pat
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
+// The table's rows as words; the comment line above the header ("# ...") is left out.
 std::vector<std::vector<std::string>> words(const fs::path& path) {
   std::ifstream in(path);
   std::vector<std::vector<std::string>> rows;
   for (std::string line; std::getline(in, line);) {
+    if (line.rfind('#', 0) == 0) continue;
     std::istringstream w(line);
     rows.emplace_back();
     for (std::string s; w >> s;) rows.back().push_back(s);
@@ -58,43 +62,90 @@ class CompareTool : public ::testing::Test {
 };
 fs::path CompareTool::dir_;
 
-TEST_F(CompareTool, PrintsOneRowPerMethodAndTheJsonBesideIt) {
+TEST_F(CompareTool, PrintsOneRowPerMethodAndSettingAndTheJsonBesideIt) {
   const fs::path out = dir_ / "table.txt", json = dir_ / "table.json";
   ASSERT_EQ(runTool("acvo_compare",
                     "'" + (dir_ / "room").string() + "' --json '" + json.string() + "'", out),
             0);
+  const std::string text = readText(out);
+  EXPECT_EQ(text.rfind("# acvo on 1_thread;", 0), 0u) << "the header says acvo's threads";
   const auto rows = words(out);
-  ASSERT_EQ(rows.size(), 5u) << readText(out);
-  const std::vector<std::string> header = {"dataset",     "method", "rpe_t_m/s",
-                                           "rpe_r_deg/s", "ate_m",  "lost",
-                                           "median_ms",   "p90_ms", "vs_rgbd"};
+  // acvo on one thread; each OpenCV odometry at 4 m and 10 m and its best setting again.
+  const std::vector<std::pair<std::string, std::string>> expected = {
+      {"acvo", "1_thread"}, {"rgbd", "4m"},     {"rgbd", "10m"},     {"rgbd_best", ""},
+      {"icp", "4m"},        {"icp", "10m"},     {"icp_best", ""},    {"rgbd_icp", "4m"},
+      {"rgbd_icp", "10m"},  {"rgbd_icp_best", ""}};
+  ASSERT_EQ(rows.size(), expected.size() + 1) << text;
+  const std::vector<std::string> header = {
+      "dataset", "method", "setting",   "rpe_t_m/s", "rpe_r_deg/s", "ate_m",
+      "lost",    "median_ms", "cpu_ms", "spread_%",  "vs_rgbd"};
   EXPECT_EQ(rows[0], header);
-  const std::vector<std::string> methods = {"acvo", "rgbd", "icp", "rgbd_icp"};
-  for (std::size_t k = 0; k < methods.size(); ++k) {
+  for (std::size_t k = 0; k < expected.size(); ++k) {
     const auto& row = rows[k + 1];
-    ASSERT_EQ(row.size(), header.size()) << methods[k];
+    ASSERT_EQ(row.size(), header.size()) << text;
     EXPECT_EQ(row[0], "room");
-    EXPECT_EQ(row[1], methods[k]);
-    for (std::size_t c = 2; c < row.size(); ++c) {
-      EXPECT_TRUE(std::isfinite(std::stod(row[c]))) << methods[k] << " " << header[c];
-      EXPECT_GE(std::stod(row[c]), 0.0) << methods[k] << " " << header[c];
+    EXPECT_EQ(row[1], expected[k].first);
+    if (!expected[k].second.empty()) {
+      EXPECT_EQ(row[2], expected[k].second);
     }
-    EXPECT_EQ(row[5].find('.'), std::string::npos) << "lost is a count: " << row[5];
+    for (std::size_t c = 3; c < row.size(); ++c) {
+      EXPECT_TRUE(std::isfinite(std::stod(row[c]))) << row[1] << " " << header[c];
+      EXPECT_GE(std::stod(row[c]), 0.0) << row[1] << " " << header[c];
+    }
+    EXPECT_EQ(row[6].find('.'), std::string::npos) << "lost is a count: " << row[6];
+    EXPECT_EQ(row[9], "0.0") << "one run: no spread";
   }
-  EXPECT_EQ(rows[2][8], "1.00");  // the reference of the speed ratio
+  // A best row repeats one of its method's settings, figure for figure.
+  for (std::size_t k : {3u, 6u, 9u}) {
+    const auto& best = rows[k + 1];
+    const bool first = std::equal(best.begin() + 2, best.end(), rows[k - 1].begin() + 2);
+    const bool second = std::equal(best.begin() + 2, best.end(), rows[k].begin() + 2);
+    EXPECT_TRUE(first || second) << best[1];
+  }
+  // The speed reference: the best RgbdOdometry setting, 1.00.
+  EXPECT_EQ(rows[4][10], "1.00");
   // acvo tracks this room closely (measured about 0.01 m/s, 0.2 deg/s over 40 frames).
-  EXPECT_LT(std::stod(rows[1][2]), 0.03);
-  EXPECT_LT(std::stod(rows[1][3]), 0.6);
-  EXPECT_EQ(rows[1][5], "0");
+  EXPECT_LT(std::stod(rows[1][3]), 0.03);
+  EXPECT_LT(std::stod(rows[1][4]), 0.6);
+  EXPECT_EQ(rows[1][6], "0");
 
   const std::string j = readText(json);
-  EXPECT_EQ(count(j, "\"method\":"), 4) << j;
-  for (const auto& m : methods) EXPECT_EQ(count(j, "\"method\": \"" + m + "\""), 1) << m;
+  EXPECT_EQ(count(j, "\"method\":"), 10) << j;
+  EXPECT_EQ(count(j, "\"best\": true"), 3) << j;
   for (const char* key : {"\"rpe_trans\":", "\"rpe_rot_deg\":", "\"ate\":", "\"lost\":",
-                          "\"median_ms\":", "\"p90_ms\":", "\"median_vs_rgbd\": "}) {
-    EXPECT_EQ(count(j, key), 4) << key;
+                          "\"median_ms\":", "\"cpu_median_ms\":", "\"median_ms_runs\":",
+                          "\"spread_percent\":", "\"median_vs_rgbd\": ", "\"setting\":"}) {
+    EXPECT_EQ(count(j, key), 10) << key;
   }
-  EXPECT_EQ(count(j, "\"median_vs_rgbd\": 1,") + count(j, "\"median_vs_rgbd\": 1}"), 1) << j;
+}
+
+// --threads gives one acvo row per value, with the same trajectory (the reduction order does not
+// depend on the threads); --repeat times every run; --peer-max-depth with one value has no best
+// row.
+TEST_F(CompareTool, ThreadsRepeatAndOneDepth) {
+  const fs::path out = dir_ / "threads.txt", traj = dir_ / "traj";
+  fs::create_directories(traj);
+  ASSERT_EQ(runTool("acvo_compare",
+                    "'" + (dir_ / "room").string() +
+                        "' --methods acvo,rgbd --threads 1,0 --repeat 2 --peer-max-depth 4 "
+                        "--frames 20 --trajectories '" + traj.string() + "'",
+                    out),
+            0);
+  const std::string text = readText(out);
+  EXPECT_EQ(text.rfind("# acvo on 1_thread,all_cores;", 0), 0u) << text;
+  EXPECT_NE(text.find("median of 2 runs"), std::string::npos) << text;
+  const auto rows = words(out);
+  ASSERT_EQ(rows.size(), 4u) << text;
+  EXPECT_EQ(rows[1][2], "1_thread");
+  EXPECT_EQ(rows[2][2], "all_cores");
+  EXPECT_EQ(rows[3][1], "rgbd");
+  EXPECT_EQ(rows[3][2], "4m");
+  EXPECT_EQ(rows[3][10], "1.00");
+  for (std::size_t c = 3; c < 7; ++c) EXPECT_EQ(rows[1][c], rows[2][c]) << "column " << c;
+  const auto poses_1 = words(traj / "room-acvo-1_thread.txt");
+  EXPECT_EQ(poses_1.size(), 20u);
+  EXPECT_EQ(poses_1, words(traj / "room-acvo-all_cores.txt"));
+  EXPECT_TRUE(fs::exists(traj / "room-rgbd-4m.txt"));
 }
 
 TEST_F(CompareTool, ASubsetOfMethodsAndItsLabel) {
@@ -107,7 +158,7 @@ TEST_F(CompareTool, ASubsetOfMethodsAndItsLabel) {
   const auto rows = words(out);
   ASSERT_EQ(rows.size(), 2u);
   EXPECT_EQ(rows[1][1], "paper");
-  EXPECT_EQ(rows[1][8], "nan");  // no RgbdOdometry row to compare the speed with
+  EXPECT_EQ(rows[1][10], "nan");  // no RgbdOdometry row to compare the speed with
 }
 
 TEST_F(CompareTool, BadArgumentsExitWithStatusTwo) {
@@ -116,6 +167,9 @@ TEST_F(CompareTool, BadArgumentsExitWithStatusTwo) {
   EXPECT_EQ(runTool("acvo_compare", "", out), 2);
   EXPECT_EQ(runTool("acvo_compare", room + " --methods acvo,dvo", out), 2);
   EXPECT_EQ(runTool("acvo_compare", room + " --set solver.no_such_key=1", out), 2);
+  EXPECT_EQ(runTool("acvo_compare", room + " --threads -1", out), 2);
+  EXPECT_EQ(runTool("acvo_compare", room + " --repeat 0", out), 2);
+  EXPECT_EQ(runTool("acvo_compare", room + " --peer-max-depth 0", out), 2);
   EXPECT_EQ(runTool("acvo_compare", "'" + (dir_ / "missing").string() + "'", out), 2);
 }
 
