@@ -1,14 +1,16 @@
 // acvo_bench_kernels: Google Benchmark timings of each stage of one registration, on one pair
-// of real frames (see frame_pair.hpp): pixel selection, cloud building, cloud preparation
-// (search grid + self-kernel pairs), the cross-kernel pass (fresh and with warm candidate
-// lists), the step-size sums, the self-kernel sums and a whole align().
+// of real frames (see frame_pair.hpp): pixel selection, cloud building; for the default engine
+// a reference's search grids, the kernel pass of a level (fresh and with warm candidate lists)
+// and a whole registration; for the paper's engine the cloud preparation (search grid and
+// self-kernel pairs), its kernel pass, the step-size sums, the self-kernel sums and a whole
+// registration.
 //
 //   acvo_bench_kernels [--threads=N] [--data=TUM_DIR|synthetic] [--benchmark_* flags]
 //
 // --threads: size of the TBB arena the stages run in, as acvo_tum --threads (default 2).
 // --data: the frames (default kitchen7s_dev from the shared data, else synthetic).
-// The kernel passes run at the transform align() converges to, at ell in millimetres
-// (ell_min, ell_init, ell_max of the default parameters). Times are wall-clock ("Time"): the
+// The kernel passes run at the transform the default engine converges to, at ell in millimetres
+// (the default engine's ell_min and ell_init, the paper's ell_min and ell_max). Times are wall-clock ("Time"): the
 // work is spread over the arena's threads, which the "CPU" column (main thread) does not see.
 #include <cmath>
 #include <cstdlib>
@@ -16,15 +18,14 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <benchmark/benchmark.h>
 #include <tbb/task_arena.h>
 #include <opencv2/imgproc.hpp>
 
-#include "acvo/cross_kernel.hpp"
 #include "acvo/labelled_cloud.hpp"
 #include "acvo/point_selector.hpp"
-#include "acvo/solver.hpp"
 #include "frame_pair.hpp"
 
 namespace {
@@ -44,12 +45,29 @@ double ellOf(const benchmark::State& state) {
   return double(state.range(0)) / 1000.0;
 }
 
-// The length-scales the kernel benchmarks run at: the solver's bounds and its start value.
-void ellArguments(benchmark::internal::Benchmark* b) {
-  const acvo::SolverParams p;
+// The length-scales the kernel benchmarks run at (mm, rounded; the level kernels run at the
+// level nearest to it).
+void levelArguments(benchmark::internal::Benchmark* b) {
+  const acvo::CoarseToFineParams p;
   b->ArgName("ell_mm");
-  for (double ell : {p.ell_min, p.ell_init, p.ell_max}) b->Arg(std::lround(ell * 1000.0));
+  for (double ell : {p.ell_min, p.ell_init}) b->Arg(std::lround(ell * 1000.0));
   b->Unit(benchmark::kMillisecond)->UseRealTime();
+}
+void paperArguments(benchmark::internal::Benchmark* b) {
+  const acvo::PaperParams p;
+  b->ArgName("ell_mm");
+  for (double ell : {p.ell_min, p.ell_max}) b->Arg(std::lround(ell * 1000.0));
+  b->Unit(benchmark::kMillisecond)->UseRealTime();
+}
+
+// The default engine's level whose length-scale is nearest the benchmark's argument.
+std::size_t levelOf(const benchmark::State& state) {
+  const std::vector<double> ells = acvo::levelElls(g_pair->params.coarse_to_fine);
+  std::size_t best = 0;
+  for (std::size_t k = 0; k < ells.size(); ++k) {
+    if (std::abs(ells[k] - ellOf(state)) < std::abs(ells[best] - ellOf(state))) best = k;
+  }
+  return best;
 }
 
 void BM_Selection(benchmark::State& state) {
@@ -83,54 +101,102 @@ void BM_BuildCloud(benchmark::State& state) {
 }
 BENCHMARK(BM_BuildCloud)->Unit(benchmark::kMillisecond)->UseRealTime();
 
-void BM_PrepareCloud(benchmark::State& state) {
+void BM_PrepareReference(benchmark::State& state) {
+  inArena([&] {
+    for (auto _ : state) {
+      state.PauseTiming();  // a fresh copy of the cloud, untimed
+      auto c = acvo::prepareCoarseToFine(g_pair->moving->cloud, g_pair->params.coarse_to_fine,
+                                         false);
+      state.ResumeTiming();
+      acvo::prepareCoarseToFineReference(*c, g_pair->params.coarse_to_fine);
+      benchmark::DoNotOptimize(c->level_grids.data());
+    }
+  });
+  state.counters["points"] = double(g_pair->moving->size());
+}
+BENCHMARK(BM_PrepareReference)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// A new kernel per pass: the candidate lists are built every time (a level's first iteration).
+void BM_LevelKernelFresh(benchmark::State& state) {
+  std::int64_t nnz = 0;
+  const std::size_t level = levelOf(state);
+  const double ell = acvo::levelElls(g_pair->params.coarse_to_fine)[level];
+  inArena([&] {
+    for (auto _ : state) {
+      acvo::LevelKernel k(g_pair->fixed->cloud, g_pair->moving->cloud,
+                          g_pair->fixed->level_grids[level], g_pair->params.coarse_to_fine);
+      nnz = k.evaluate(g_pair->aligned, ell).nnz;
+    }
+  });
+  state.counters["nnz"] = double(nnz);
+}
+BENCHMARK(BM_LevelKernelFresh)->Apply(levelArguments);
+
+// One kernel evaluated again at the same transform: its candidate lists stay valid, so this is
+// the cost of a later iteration.
+void BM_LevelKernelWarm(benchmark::State& state) {
+  const std::size_t level = levelOf(state);
+  const double ell = acvo::levelElls(g_pair->params.coarse_to_fine)[level];
+  acvo::LevelKernel k(g_pair->fixed->cloud, g_pair->moving->cloud,
+                      g_pair->fixed->level_grids[level], g_pair->params.coarse_to_fine);
+  std::int64_t nnz = 0;
+  inArena([&] {
+    k.evaluate(g_pair->aligned, ell);
+    const int builds = k.listBuilds();
+    for (auto _ : state) nnz = k.evaluate(g_pair->aligned, ell).nnz;
+    if (k.listBuilds() != builds) state.SkipWithError("candidate lists were rebuilt");
+  });
+  state.counters["nnz"] = double(nnz);
+}
+BENCHMARK(BM_LevelKernelWarm)->Apply(levelArguments);
+
+// A whole registration of the default engine from the identity guess.
+void BM_Align(benchmark::State& state) {
+  int iterations = 0;
+  inArena([&] {
+    for (auto _ : state) {
+      const acvo::SolverResult r =
+          acvo::alignCoarseToFine(*g_pair->fixed, *g_pair->moving, Eigen::Isometry3d::Identity(),
+                                  g_pair->params.coarse_to_fine);
+      iterations = r.iterations;
+      benchmark::DoNotOptimize(r.transform);
+    }
+  });
+  state.counters["iterations"] = iterations;
+}
+BENCHMARK(BM_Align)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_PaperPrepareCloud(benchmark::State& state) {
   std::size_t self_pairs = 0;
   inArena([&] {
     for (auto _ : state) {
-      state.PauseTiming();  // prepareCloud takes the cloud by value: copy it untimed
-      acvo::LabelledCloud cloud = g_pair->moving.cloud;
+      state.PauseTiming();  // preparePaper takes the cloud by value: copy it untimed
+      acvo::LabelledCloud cloud = g_pair->moving->cloud;
       state.ResumeTiming();
-      const acvo::PreparedCloud p = acvo::prepareCloud(std::move(cloud), g_pair->params.solver);
-      self_pairs = p.self_pairs.size();
-      benchmark::DoNotOptimize(p.self_d2.data());
+      const auto p = acvo::preparePaper(std::move(cloud), g_pair->paper, false);
+      self_pairs = p->self_pairs.size();
+      benchmark::DoNotOptimize(p->self_d2.data());
     }
   });
-  state.counters["points"] = double(g_pair->moving.size());
+  state.counters["points"] = double(g_pair->moving->size());
   state.counters["self_pairs"] = double(self_pairs);
 }
-BENCHMARK(BM_PrepareCloud)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_PaperPrepareCloud)->Unit(benchmark::kMillisecond)->UseRealTime();
 
-// A new CrossKernel per pass: the candidate lists are built every time (first iteration of a
-// registration).
-void BM_CrossKernelFresh(benchmark::State& state) {
+void BM_PaperKernel(benchmark::State& state) {
+  acvo::PaperKernel k(g_pair->paper_fixed->cloud, g_pair->paper_moving->cloud,
+                      g_pair->paper_fixed->grid, g_pair->paper);
   std::int64_t nnz = 0;
   inArena([&] {
-    for (auto _ : state) {
-      acvo::CrossKernel k(g_pair->fixed, g_pair->moving, g_pair->params.solver);
-      nnz = k.evaluate(g_pair->aligned, ellOf(state)).nnz;
-    }
-  });
-  state.counters["nnz"] = double(nnz);
-}
-BENCHMARK(BM_CrossKernelFresh)->Apply(ellArguments);
-
-// One CrossKernel evaluated again at the same transform: its candidate lists stay valid, so
-// this is the cost of a later iteration.
-void BM_CrossKernelWarm(benchmark::State& state) {
-  acvo::CrossKernel k(g_pair->fixed, g_pair->moving, g_pair->params.solver);
-  std::int64_t nnz = 0;
-  inArena([&] {
-    k.evaluate(g_pair->aligned, ellOf(state));
-    const int builds = k.candidateListBuilds();
     for (auto _ : state) nnz = k.evaluate(g_pair->aligned, ellOf(state)).nnz;
-    if (k.candidateListBuilds() != builds) state.SkipWithError("candidate lists were rebuilt");
   });
   state.counters["nnz"] = double(nnz);
 }
-BENCHMARK(BM_CrossKernelWarm)->Apply(ellArguments);
+BENCHMARK(BM_PaperKernel)->Apply(paperArguments);
 
-void BM_StepSums(benchmark::State& state) {
-  acvo::CrossKernel k(g_pair->fixed, g_pair->moving, g_pair->params.solver);
+void BM_PaperStepSums(benchmark::State& state) {
+  acvo::PaperKernel k(g_pair->paper_fixed->cloud, g_pair->paper_moving->cloud,
+                      g_pair->paper_fixed->grid, g_pair->paper);
   inArena([&] {
     const acvo::CrossSums s = k.evaluate(g_pair->aligned, ellOf(state));
     for (auto _ : state) {
@@ -140,36 +206,36 @@ void BM_StepSums(benchmark::State& state) {
     state.counters["nnz"] = double(s.nnz);
   });
 }
-BENCHMARK(BM_StepSums)->Apply(ellArguments);
+BENCHMARK(BM_PaperStepSums)->Apply(paperArguments);
 
-void BM_SelfKernelSums(benchmark::State& state) {
+void BM_PaperSelfKernelSums(benchmark::State& state) {
   std::int64_t nnz = 0;
   inArena([&] {
     for (auto _ : state) {
       const acvo::SelfSums s =
-          acvo::selfKernelSums(g_pair->fixed, ellOf(state), g_pair->params.solver);
+          acvo::selfKernelSums(*g_pair->paper_fixed, ellOf(state), g_pair->paper);
       nnz = s.nnz;
       benchmark::DoNotOptimize(s);
     }
   });
   state.counters["nnz"] = double(nnz);
 }
-BENCHMARK(BM_SelfKernelSums)->Apply(ellArguments);
+BENCHMARK(BM_PaperSelfKernelSums)->Apply(paperArguments);
 
-// A whole registration from the identity guess, as the odometry's first pair.
-void BM_Align(benchmark::State& state) {
+// A whole registration of the paper's A-CVO from the identity guess.
+void BM_PaperAlign(benchmark::State& state) {
   int iterations = 0;
   inArena([&] {
     for (auto _ : state) {
-      const acvo::SolverResult r = acvo::align(
-          g_pair->fixed, g_pair->moving, Eigen::Isometry3d::Identity(), g_pair->params.solver);
+      const acvo::SolverResult r = acvo::alignPaper(*g_pair->paper_fixed, *g_pair->paper_moving,
+                                                    Eigen::Isometry3d::Identity(), g_pair->paper);
       iterations = r.iterations;
       benchmark::DoNotOptimize(r.transform);
     }
   });
   state.counters["iterations"] = iterations;
 }
-BENCHMARK(BM_Align)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_PaperAlign)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // Takes --name=value off argv (Google Benchmark has removed its own flags already).
 std::optional<std::string> takeFlag(int* argc, char** argv, const std::string& name) {
@@ -212,8 +278,8 @@ int main(int argc, char** argv) {
   }
   benchmark::AddCustomContext("acvo_data", g_pair->source);
   benchmark::AddCustomContext("acvo_threads", std::to_string(threads));
-  benchmark::AddCustomContext("acvo_points", std::to_string(g_pair->fixed.size()) + " fixed, " +
-                                                 std::to_string(g_pair->moving.size()) + " moving");
+  benchmark::AddCustomContext("acvo_points", std::to_string(g_pair->fixed->size()) + " fixed, " +
+                                                 std::to_string(g_pair->moving->size()) + " moving");
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
   return 0;

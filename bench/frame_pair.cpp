@@ -5,7 +5,6 @@
 #include <stdexcept>
 
 #include "acvo/labelled_cloud.hpp"
-#include "acvo/solver.hpp"
 #include "acvo/tum.hpp"
 #include "synth/sequence.hpp"
 
@@ -41,12 +40,15 @@ FramePair loadFramePair(const std::string& data) {
     pair.fixed_frame = dataset.loadFrame(0);
     pair.moving_frame = dataset.loadFrame(1);
   }
-  pair.fixed =
-      prepareCloud(buildLabelledCloud(pair.fixed_frame, pair.params.selection), pair.params.solver);
-  pair.moving = prepareCloud(buildLabelledCloud(pair.moving_frame, pair.params.selection),
-                             pair.params.solver);
-  pair.aligned =
-      align(pair.fixed, pair.moving, Eigen::Isometry3d::Identity(), pair.params.solver).transform;
+  const LabelledCloud fixed = buildLabelledCloud(pair.fixed_frame, pair.params.selection);
+  const LabelledCloud moving = buildLabelledCloud(pair.moving_frame, pair.params.selection);
+  pair.fixed = prepareCoarseToFine(fixed, pair.params.coarse_to_fine, true);
+  pair.moving = prepareCoarseToFine(moving, pair.params.coarse_to_fine, false);
+  pair.paper_fixed = preparePaper(fixed, pair.paper, true);
+  pair.paper_moving = preparePaper(moving, pair.paper, false);
+  pair.aligned = alignCoarseToFine(*pair.fixed, *pair.moving, Eigen::Isometry3d::Identity(),
+                                   pair.params.coarse_to_fine)
+                     .transform;
   return pair;
 }
 

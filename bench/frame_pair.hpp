@@ -6,19 +6,25 @@
 
 #include <Eigen/Geometry>
 
+#include <memory>
+
 #include "acvo/frame.hpp"
-#include "acvo/kernel.hpp"
 #include "acvo/params.hpp"
+#include "acvo/registration/coarse_to_fine.hpp"
+#include "acvo/registration/paper.hpp"
 
 namespace acvo::bench {
 
 struct FramePair {
   std::string source;  // what the frames are, for the benchmark labels
   Frame fixed_frame, moving_frame;
-  Params params;
-  PreparedCloud fixed, moving;  // both frames' clouds, prepared as the odometry does
-  // Where align() converges from the identity guess: the kernel benchmarks evaluate there, so
-  // that they see the pairs of a registration near its end.
+  Params params;  // the defaults; paper: paperParams()
+  // Both frames' clouds as each engine prepares them (the fixed one as a reference).
+  std::shared_ptr<CoarseToFineCloud> fixed, moving;
+  std::shared_ptr<PaperCloud> paper_fixed, paper_moving;
+  PaperParams paper = paperParams().paper;
+  // Where the default engine converges from the identity guess: the kernel benchmarks evaluate
+  // there, so that they see the pairs of a registration near its end.
   Eigen::Isometry3d aligned = Eigen::Isometry3d::Identity();
 };
 

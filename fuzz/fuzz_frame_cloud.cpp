@@ -27,11 +27,11 @@
 
 #include "acvo/depth.hpp"
 #include "acvo/frame.hpp"
-#include "acvo/kernel.hpp"
+#include "acvo/registration/coarse_to_fine.hpp"
+#include "acvo/registration/paper.hpp"
 #include "acvo/labelled_cloud.hpp"
 #include "acvo/odometry.hpp"
 #include "acvo/se3.hpp"
-#include "acvo/solver.hpp"
 #include "fuzz_input.hpp"
 
 #define FUZZ_CHECK(cond)                                                                  \
@@ -122,8 +122,8 @@ Decoded decode(const std::uint8_t* data, std::size_t size) {
   d.shift_y = in.byte() % 8 - 4;
   d.params.selection.target_points = 20 + in.byte();
   // Fewer iterations than the defaults keep a run short; every exit of the loops stays reachable.
-  d.params.solver.max_iterations = 30;
-  d.params.solver.coarse_iterations = 5;
+  d.params.paper.max_iterations = 30;
+  d.params.paper.coarse_iterations = 5;
   d.params.odometry.threads = 1;
 
   acvo::Camera& cam = d.frame.camera;
@@ -233,10 +233,16 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const acvo::LabelledCloud moved_cloud = acvo::buildLabelledCloud(moved, d.params.selection);
   checkCloud(moved_cloud, moved);
 
-  const acvo::PreparedCloud a = acvo::prepareCloud(cloud, d.params.solver);
-  const acvo::PreparedCloud b = acvo::prepareCloud(moved_cloud, d.params.solver);
-  checkSolverResult(acvo::align(a, a, Eigen::Isometry3d::Identity(), d.params.solver));
-  checkSolverResult(acvo::align(a, b, d.guess, d.params.solver));
+  // Both engines, on the same clouds.
+  const auto a = acvo::prepareCoarseToFine(cloud, d.params.coarse_to_fine, true);
+  const auto b = acvo::prepareCoarseToFine(moved_cloud, d.params.coarse_to_fine, false);
+  checkSolverResult(
+      acvo::alignCoarseToFine(*a, *a, Eigen::Isometry3d::Identity(), d.params.coarse_to_fine));
+  checkSolverResult(acvo::alignCoarseToFine(*a, *b, d.guess, d.params.coarse_to_fine));
+  const auto pa = acvo::preparePaper(cloud, d.params.paper, true);
+  const auto pb = acvo::preparePaper(moved_cloud, d.params.paper, false);
+  checkSolverResult(acvo::alignPaper(*pa, *pa, Eigen::Isometry3d::Identity(), d.params.paper));
+  checkSolverResult(acvo::alignPaper(*pa, *pb, d.guess, d.params.paper));
 
   for (const acvo::Frame* f : {&frame, &moved, &frame}) {
     const acvo::OdometryResult r = odometry.process(*f);

@@ -18,8 +18,6 @@
 
 namespace acvo {
 
-struct SolverResult;
-
 // Variance (m^2 and rad^2) that tells consumers "do not trust this".
 constexpr double kLostVariance = 1e6;
 // Diagonal of the pose covariance right after a (re)start: the origin is known exactly, the
@@ -41,13 +39,11 @@ Matrix6d rotateCovariance(const Matrix6d& c, const Eigen::Matrix3d& a_from_b);
 // lostCovariance() (nothing can be said of the motion).
 Matrix6d sanitiseCovariance(const Matrix6d& c);
 
-// Covariance of a registered motion (T: moving -> fixed, in the fixed frame's axes):
-// covariance_scale * (-H)^-1, H = SolverResult::hessian, times the kernel pairs per moving
-// point for the paper's policies (their curvature sums pairs, which are not independent).
-// nullopt when H does not constrain every direction (an eigenvalue below 1e-12 of the
+// covariance_scale * info^-1 for the information `info` of a registration (the negative of its
+// curvature at the optimum; each engine scales it its own way, RegistrationEngine::covariance).
+// nullopt when info does not constrain every direction (an eigenvalue below 1e-12 of the
 // largest) or the result is not finite.
-std::optional<Matrix6d> motionCovariance(const SolverResult& s, const SolverParams& solver,
-                                         double covariance_scale, std::size_t moving_points);
+std::optional<Matrix6d> scaledInverseInformation(const Matrix6d& info, double covariance_scale);
 
 // What the covariance of a held pose gains while the camera is unseen for `seconds`:
 // (lost_angular_speed t)^2 on the rotation diagonal, (lost_speed t)^2 on the translation's.

@@ -12,11 +12,10 @@
 
 #include "acvo/covariance.hpp"
 #include "acvo/frame.hpp"
-#include "acvo/kernel.hpp"
 #include "acvo/labelled_cloud.hpp"
 #include "acvo/params.hpp"
+#include "acvo/registration.hpp"
 #include "acvo/se3.hpp"
-#include "acvo/solver.hpp"
 
 namespace acvo {
 
@@ -65,8 +64,8 @@ struct OdometryResult {
 //    the frame's points found a kernel partner (nothing in common: noise, another view), or the
 //    motion exceeds max_translation / max_rotation per frame. A low overlap alone is not lost:
 //    a fast motion registered from the part of the view it keeps is kept.
-//  - hard: matched below hard_matched_fraction, iteration cap reached, or (adaptive policy)
-//    the length-scale reached its upper bound at least hard_ell_reductions times.
+//  - hard: matched below hard_matched_fraction, iteration cap reached, or the engine found it
+//    hard (SolverResult::hard: the paper's length-scale kept reaching its upper bound).
 //  - ok otherwise.
 struct Judgement {
   Tracking tracking = Tracking::kOk;
@@ -153,6 +152,7 @@ class Odometry {
             const std::shared_ptr<PreparedCloud>& current, double stamp);
 
   Params params_;
+  std::unique_ptr<RegistrationEngine> engine_;  // the engine params_ name
   Eigen::Isometry3d pose_ = Eigen::Isometry3d::Identity();
   Matrix6d pose_covariance_;
   Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();  // last frame-to-frame motion

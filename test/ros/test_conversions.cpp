@@ -330,33 +330,37 @@ TEST(RosParams, ReadsEverySectionWithCoreNamesAndReportsProblems) {
   XmlRpc::XmlRpcValue ns;
   ns["selection"] = section("target_points", 1234);
   ns["selection"]["max_depth"] = 4;  // an integer is fine for a double
-  ns["solver"] =
+  ns["registration"] = section("engine", std::string(acvo::toString(acvo::Engine::kPaper)));
+  ns["paper"] =
       section("ell_policy", std::string(acvo::toString(acvo::EllPolicy::kFixedSchedule)));
-  ns["solver"]["max_iterations"] = 2.5;  // wrong type: reported, default kept
-  ns["solver"]["no_such_key"] = 1;
+  ns["paper"]["max_iterations"] = 2.5;  // wrong type: reported, default kept
+  ns["coarse_to_fine"] = section("no_such_key", 1);
   ns["odometry"] = section("initial_guess", std::string("sideways"));
   ns["approx_sync"] = true;  // a nodelet setting, not an algorithm parameter
   acvo::Params p;
   const std::vector<std::string> problems = applyRosParams(ns, p);
   EXPECT_EQ(p.selection.target_points, 1234);
   EXPECT_DOUBLE_EQ(p.selection.max_depth, 4.0);
-  EXPECT_EQ(p.solver.ell_policy, acvo::EllPolicy::kFixedSchedule);
-  EXPECT_EQ(p.solver.max_iterations, acvo::Params().solver.max_iterations);
+  EXPECT_EQ(p.registration.engine, acvo::Engine::kPaper);
+  EXPECT_EQ(p.paper.ell_policy, acvo::EllPolicy::kFixedSchedule);
+  EXPECT_EQ(p.paper.max_iterations, acvo::Params().paper.max_iterations);
   EXPECT_EQ(p.odometry.initial_guess, acvo::Params().odometry.initial_guess);
   ASSERT_EQ(problems.size(), 3u);
   std::string all;
   for (const auto& s : problems) all += s + "\n";
-  EXPECT_NE(all.find("~solver/max_iterations"), std::string::npos) << all;
+  EXPECT_NE(all.find("~paper/max_iterations"), std::string::npos) << all;
   EXPECT_NE(all.find("~odometry/initial_guess"), std::string::npos) << all;
-  EXPECT_NE(all.find("~solver/no_such_key"), std::string::npos) << all;
+  EXPECT_NE(all.find("~coarse_to_fine/no_such_key"), std::string::npos) << all;
 }
 
 TEST(RosParams, ReconfigureRoundTripsAndDescribesEveryParameter) {
   acvo::Params p;
   p.selection.target_points = 777;
-  p.solver.ell_policy = acvo::EllPolicy::kFixedSchedule;
+  p.registration.engine = acvo::Engine::kPaper;
+  p.paper.ell_policy = acvo::EllPolicy::kFixedSchedule;
+  p.paper.color_ell = 0.25;
+  p.coarse_to_fine.depth_noise = 0.001;
   p.odometry.initial_guess = acvo::InitialGuess::kIdentity;
-  p.solver.sparsification = 1e-3;
   const acvo::AcvoConfig c = toConfig(p, LostOdom::kNone);
   EXPECT_EQ(c.lost_odom, "none");
   const acvo::Params back = fromConfig(c, acvo::Params());
@@ -381,8 +385,13 @@ TEST(RosParams, EveryReconfigureEnumValueIsAcceptedByTheCore) {
   // The .cfg lists the enum strings; they must be the core's own spellings.
   for (const auto& v : {acvo::EllPolicy::kAdaptive, acvo::EllPolicy::kFixedSchedule}) {
     acvo::AcvoConfig c = toConfig(acvo::Params(), LostOdom::kHeld);
-    c.ell_policy = acvo::toString(v);
-    EXPECT_EQ(fromConfig(c, acvo::Params()).solver.ell_policy, v);
+    c.paper_ell_policy = acvo::toString(v);
+    EXPECT_EQ(fromConfig(c, acvo::Params()).paper.ell_policy, v);
+  }
+  for (const auto& v : {acvo::Engine::kCoarseToFine, acvo::Engine::kPaper}) {
+    acvo::AcvoConfig c = toConfig(acvo::Params(), LostOdom::kHeld);
+    c.engine = acvo::toString(v);
+    EXPECT_EQ(fromConfig(c, acvo::Params()).registration.engine, v);
   }
   acvo::AcvoConfig c = acvo::AcvoConfig::__getDefault__();
   EXPECT_NO_THROW(fromConfig(c, acvo::Params()));

@@ -947,7 +947,7 @@ TEST(OdometryNodelet, ReconfigureRestartsTrackingWithNewParametersAndRefusesBadO
   for (const auto& d : refusal.config.doubles) {
     if (d.name == "ell_min") {
       reported = true;
-      EXPECT_DOUBLE_EQ(d.value, acvo::Params().solver.ell_min);
+      EXPECT_DOUBLE_EQ(d.value, acvo::Params().coarse_to_fine.ell_min);
     }
   }
   EXPECT_TRUE(reported);

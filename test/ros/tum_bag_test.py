@@ -87,7 +87,7 @@ def parameter_overrides(config):
     with open(config) as f:
         values = yaml.safe_load(f) or {}
     args = []
-    for section in ("selection", "solver", "odometry"):
+    for section in ("selection", "registration", "coarse_to_fine", "paper", "odometry"):
         for key, value in (values.get(section) or {}).items():
             if isinstance(value, bool):
                 value = "true" if value else "false"

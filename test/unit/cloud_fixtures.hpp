@@ -5,7 +5,7 @@
 #include <cmath>
 #include <random>
 
-#include "acvo/kernel.hpp"
+#include "acvo/labelled_cloud.hpp"
 #include "acvo/params.hpp"
 
 namespace acvo::test {
@@ -32,15 +32,17 @@ inline LabelledCloud transformed(const LabelledCloud& c, const Eigen::Isometry3d
   return out;
 }
 
-// sum_ij a_ij and friends in double, with the same sparsification rule (a >= threshold).
+// sum_ij a_ij and friends in double, with the same sparsification rule (a >= threshold), for
+// either engine's kernel constants (sigma, color_ell, color_sigma, sparsification).
 struct BruteForce {
   double F = 0, F_d2 = 0;
   long nnz = 0;
   Eigen::Vector3d omega_sum = Eigen::Vector3d::Zero(), v_sum = Eigen::Vector3d::Zero();
 };
 
-inline BruteForce bruteForce(const LabelledCloud& X, const LabelledCloud& Z,
-                             const Eigen::Isometry3d& T, double ell, const SolverParams& p) {
+template <typename KernelParams>
+BruteForce bruteForce(const LabelledCloud& X, const LabelledCloud& Z, const Eigen::Isometry3d& T,
+                      double ell, const KernelParams& p) {
   BruteForce b;
   for (std::size_t j = 0; j < Z.size(); ++j) {
     const Eigen::Vector3d y = T * Z.points[j].cast<double>();

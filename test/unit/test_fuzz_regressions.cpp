@@ -13,7 +13,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/core.hpp>
 
-#include "acvo/kernel.hpp"
+#include "acvo/registration/kernel.hpp"
 #include "acvo/labelled_cloud.hpp"
 #include "acvo/odometry.hpp"
 #include "acvo/tum.hpp"

@@ -1,8 +1,9 @@
 // Kernel, sparsification and neighbour structures (docs/method.md §2, §5).
 #include <gtest/gtest.h>
 
-#include "acvo/cross_kernel.hpp"
-#include "acvo/kernel.hpp"
+#include "acvo/registration/kernel.hpp"
+#include "acvo/registration/paper.hpp"
+#include "acvo/registration/paper_kernel.hpp"
 #include "acvo/se3.hpp"
 #include "cloud_fixtures.hpp"
 
@@ -42,13 +43,13 @@ TEST(VoxelGrid, CandidatesContainEveryPointWithinOneCell) {
   }
 }
 
-TEST(CrossKernel, EqualsBruteForceOnRandomClouds) {
-  SolverParams p = paperParams().solver;
+TEST(PaperKernel, EqualsBruteForceOnRandomClouds) {
+  const PaperParams p = paperParams().paper;
   const LabelledCloud X = test::randomCloud(1500, 1, 0.5f);
   Eigen::Isometry3d motion = expSE3((Vector6d() << 0.02, -0.01, 0.03, 0.02, 0.01, -0.03).finished());
   const LabelledCloud Z = test::transformed(test::randomCloud(1500, 1, 0.5f), motion.inverse());
-  const PreparedCloud fx = prepareCloud(X, p), mz = prepareCloud(Z, p);
-  CrossKernel kernel(fx, mz, p);
+  const auto fx = preparePaper(X, p, true), mz = preparePaper(Z, p, false);
+  PaperKernel kernel(fx->cloud, mz->cloud, fx->grid, p);
   for (double ell : {0.15, 0.1, 0.05}) {
     const CrossSums& s = kernel.evaluate(Eigen::Isometry3d::Identity(), ell);
     const test::BruteForce b = test::bruteForce(X, Z, Eigen::Isometry3d::Identity(), ell, p);
@@ -62,11 +63,11 @@ TEST(CrossKernel, EqualsBruteForceOnRandomClouds) {
   }
 }
 
-TEST(CrossKernel, KeptEntriesAreAboveTheThreshold) {
-  SolverParams p = paperParams().solver;
+TEST(PaperKernel, KeptEntriesAreAboveTheThreshold) {
+  const PaperParams p = paperParams().paper;
   const LabelledCloud X = test::randomCloud(800, 3, 0.4f);
-  const PreparedCloud fx = prepareCloud(X, p), mz = prepareCloud(X, p);
-  CrossKernel kernel(fx, mz, p);
+  const auto fx = preparePaper(X, p, true), mz = preparePaper(X, p, false);
+  PaperKernel kernel(fx->cloud, mz->cloud, fx->grid, p);
   const CrossSums& s = kernel.evaluate(Eigen::Isometry3d::Identity(), 0.1);
   // Every kept entry is >= threshold, so the mean is too; and self-pairs are counted.
   ASSERT_GT(s.nnz, 0);
@@ -75,18 +76,18 @@ TEST(CrossKernel, KeptEntriesAreAboveTheThreshold) {
 }
 
 TEST(SelfKernel, PairsEqualBruteForce) {
-  SolverParams p = paperParams().solver;
+  const PaperParams p = paperParams().paper;
   const LabelledCloud X = test::randomCloud(1000, 4, 0.4f);
-  const PreparedCloud fx = prepareCloud(X, p);
+  const auto fx = preparePaper(X, p, true);
   for (double ell : {0.15, 0.08, 0.04}) {
-    const SelfSums s = selfKernelSums(fx, ell, p);
+    const SelfSums s = selfKernelSums(*fx, ell, p);
     const test::BruteForce b = test::bruteForce(X, X, Eigen::Isometry3d::Identity(), ell, p);
     EXPECT_NEAR(double(s.nnz), double(b.nnz), 4.0);
     EXPECT_NEAR(s.sum, b.F, 1e-5 * b.F + 4 * p.sparsification);
     EXPECT_NEAR(s.sum_d2, b.F_d2, 1e-4 * b.F_d2 + 1e-6);
   }
   // Rows below first_row are dropped: with first_row = n nothing is left.
-  EXPECT_EQ(selfKernelSums(fx, 0.1, p, 1000).nnz, 0);
+  EXPECT_EQ(selfKernelSums(*fx, 0.1, p, 1000).nnz, 0);
 }
 
 }  // namespace

@@ -11,7 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "acvo/odometry.hpp"
-#include "acvo/solver.hpp"
+#include "acvo/registration.hpp"
 #include "cloud_fixtures.hpp"
 #include "synth/sequence.hpp"
 
@@ -33,8 +33,9 @@ LabelledCloud identicalPoints(int n) {
 }
 
 SolverResult alignClouds(const LabelledCloud& fixed, const LabelledCloud& moving) {
-  const SolverParams p;
-  return align(prepareCloud(fixed, p), prepareCloud(moving, p), Eigen::Isometry3d::Identity(), p);
+  const auto engine = makeRegistrationEngine(Params());
+  return engine->align(*engine->prepare(fixed, true), *engine->prepare(moving, false),
+                       Eigen::Isometry3d::Identity());
 }
 
 TEST(NumericFaults, CloudsOfIdenticalPointsGiveAStatusAndAFiniteTransform) {
@@ -47,7 +48,7 @@ TEST(NumericFaults, CloudsOfIdenticalPointsGiveAStatusAndAFiniteTransform) {
       const SolverResult r = alignClouds(*fixed, *moving);
       EXPECT_TRUE(r.transform.matrix().allFinite()) << toString(r.status);
       EXPECT_TRUE(std::isfinite(r.inner_product)) << toString(r.status);
-      if (n < SolverParams().min_points) {
+      if (n < CoarseToFineParams().min_points) {
         EXPECT_EQ(r.status, SolverStatus::kTooFewPoints);
       }
     }

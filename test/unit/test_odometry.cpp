@@ -338,19 +338,23 @@ TEST(Covariance, OfAMotionIsTheScaledInverseCurvatureAndNoneWhenADirectionIsFree
   s.hessian = -Matrix6d::Identity() * 4.0;
   s.hessian(5, 5) = -16.0;
   s.nnz = 6000;
-  const SolverParams coarse_to_fine;
-  const std::optional<Matrix6d> c = motionCovariance(s, coarse_to_fine, 2.0, 3000);
+  Params params;
+  params.coarse_to_fine.covariance_scale = 2.0;
+  const auto coarse_to_fine = makeRegistrationEngine(params);
+  const std::optional<Matrix6d> c = coarse_to_fine->covariance(s, 3000);
   ASSERT_TRUE(c);
   EXPECT_NEAR((*c)(0, 0), 0.5, 1e-12);  // 2 / 4
   EXPECT_NEAR((*c)(5, 5), 0.125, 1e-12);
-  // The paper's policies: times the kernel pairs per moving point (2 here).
-  const std::optional<Matrix6d> paper = motionCovariance(s, paperParams().solver, 2.0, 3000);
+  // The paper's engine: times the kernel pairs per moving point (2 here).
+  params.registration.engine = Engine::kPaper;
+  params.paper.covariance_scale = 2.0;
+  const std::optional<Matrix6d> paper = makeRegistrationEngine(params)->covariance(s, 3000);
   ASSERT_TRUE(paper);
   EXPECT_NEAR((*paper)(0, 0), 1.0, 1e-12);
   s.hessian(2, 2) = 0.0;  // nothing constrains rotation about z
-  EXPECT_FALSE(motionCovariance(s, coarse_to_fine, 2.0, 3000));
+  EXPECT_FALSE(coarse_to_fine->covariance(s, 3000));
   s.hessian(2, 2) = std::nan("");
-  EXPECT_FALSE(motionCovariance(s, coarse_to_fine, 2.0, 3000));
+  EXPECT_FALSE(coarse_to_fine->covariance(s, 3000));
 }
 
 TEST(Covariance, LostGrowthIsWhatTheCameraCanMoveUnseen) {

@@ -55,26 +55,46 @@ TEST(Params, ConfigFileHoldsEveryKeyWithTheStructDefaults) {
   const Params loaded = loadParams(path);
   const auto got = flatten(loaded);
   const auto want = flatten(Params());
-  ASSERT_EQ(got.size(), 48u);  // every parameter of visitParams
+  ASSERT_EQ(got.size(), 59u);  // every parameter of visitParams
   EXPECT_EQ(got, want);
-  // Equal values could also come from keys missing in the file: check each key is written.
+  // Equal values could also come from keys missing in the file: check that each key of the
+  // sections the default engine reads is written, and that the other engine's is not there.
   const YAML::Node file = YAML::LoadFile(path);
+  EXPECT_FALSE(file["paper"]) << "the paper engine's section belongs to paper.yaml";
   visitParams(loaded, [&file](const char* section, const char* name, const auto&) {
+    if (std::string(section) == "paper") return;
     EXPECT_TRUE(file[section] && file[section][name]) << section << "." << name << " missing";
   });
 }
 
-// The paper's table is one file away: config/paper.yaml is paperParams(), every key written.
-TEST(Params, PaperFileHoldsEveryKeyWithPaperParams) {
-  const std::string path = (test::sourceDir() / "config" / "paper.yaml").string();
-  const Params loaded = loadParams(path);
-  EXPECT_EQ(flatten(loaded), flatten(paperParams()));
-  EXPECT_EQ(loaded.solver.ell_policy, EllPolicy::kAdaptive);
-  EXPECT_DOUBLE_EQ(loaded.solver.sparsification, 8.315e-3);
-  const YAML::Node file = YAML::LoadFile(path);
-  visitParams(loaded, [&file](const char* section, const char* name, const auto&) {
-    EXPECT_TRUE(file[section] && file[section][name]) << section << "." << name << " missing";
-  });
+// The paper's A-CVO and CVO are one file away each: config/paper.yaml is paperParams(),
+// config/cvo.yaml cvoParams(), every key written.
+TEST(Params, PaperAndCvoFilesHoldEveryKeyWithTheirParams) {
+  for (const auto& [file_name, expected] :
+       {std::pair{"paper.yaml", paperParams()}, std::pair{"cvo.yaml", cvoParams()}}) {
+    SCOPED_TRACE(file_name);
+    const std::string path = (test::sourceDir() / "config" / file_name).string();
+    const Params loaded = loadParams(path);
+    EXPECT_EQ(flatten(loaded), flatten(expected));
+    EXPECT_EQ(loaded.registration.engine, Engine::kPaper);
+    EXPECT_DOUBLE_EQ(loaded.paper.sparsification, 8.315e-3);
+    const YAML::Node file = YAML::LoadFile(path);
+    EXPECT_FALSE(file["coarse_to_fine"]) << "the default engine's section belongs to acvo.yaml";
+    visitParams(loaded, [&file](const char* section, const char* name, const auto&) {
+      if (std::string(section) == "coarse_to_fine") return;
+      EXPECT_TRUE(file[section] && file[section][name]) << section << "." << name << " missing";
+    });
+  }
+  EXPECT_EQ(paperParams().paper.ell_policy, EllPolicy::kAdaptive);
+  EXPECT_EQ(cvoParams().paper.ell_policy, EllPolicy::kFixedSchedule);
+}
+
+// The section that held both engines' parameters is gone: a file that still has it is told
+// where its keys went.
+TEST(Params, OldSolverSectionIsRejectedWithWhereItsKeysWent) {
+  const std::string msg = expectThrowMessage("solver:\n  ell_min: 0.01\n");
+  EXPECT_NE(msg.find("registration.engine"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("coarse_to_fine"), std::string::npos) << msg;
 }
 
 TEST(Params, EveryKeyIsReadIntoItsField) {
@@ -82,9 +102,11 @@ TEST(Params, EveryKeyIsReadIntoItsField) {
   visitParams(defaults, [&defaults](const char* section, const char* name, const auto& field) {
     using T = std::decay_t<decltype(field)>;
     std::string value;
-    if constexpr (std::is_same_v<T, EllPolicy>) {
-      value = toString(field == EllPolicy::kCoarseToFine ? EllPolicy::kFixedSchedule
-                                                         : EllPolicy::kCoarseToFine);
+    if constexpr (std::is_same_v<T, Engine>) {
+      value = toString(field == Engine::kPaper ? Engine::kCoarseToFine : Engine::kPaper);
+    } else if constexpr (std::is_same_v<T, EllPolicy>) {
+      value = toString(field == EllPolicy::kAdaptive ? EllPolicy::kFixedSchedule
+                                                     : EllPolicy::kAdaptive);
     } else if constexpr (std::is_same_v<T, EllUpdate>) {
       value = toString(field == EllUpdate::kDescent ? EllUpdate::kReference : EllUpdate::kDescent);
     } else if constexpr (std::is_same_v<T, SearchDirection>) {
@@ -102,7 +124,8 @@ TEST(Params, EveryKeyIsReadIntoItsField) {
       value = std::to_string(field + 1);
     } else {
       char buf[64];
-      std::snprintf(buf, sizeof buf, "%.17g", field * 1.01);  // stays valid for every field
+      // Stays valid for every field (a 0 that means "off" becomes 0.5).
+      std::snprintf(buf, sizeof buf, "%.17g", field == 0.0 ? 0.5 : field * 1.01);
       value = buf;
     }
     const std::string key = std::string(section) + "." + name;
@@ -120,26 +143,29 @@ TEST(Params, EveryKeyIsReadIntoItsField) {
 TEST(Params, ValuesOverrideTheBase) {
   const Params p = parseParams(
       "selection:\n  target_points: 1500\n  canny_fallback: false\n"
-      "solver:\n  ell_update: reference\n  color_ell: 0.1\n"
+      "paper:\n  ell_update: descent\n  color_ell: 0.1\n"
       "odometry:\n  initial_guess: identity\n  threads: 2\n");
   EXPECT_EQ(p.selection.target_points, 1500);
   EXPECT_FALSE(p.selection.canny_fallback);
-  EXPECT_EQ(p.solver.ell_update, EllUpdate::kReference);
-  EXPECT_DOUBLE_EQ(p.solver.color_ell, 0.1);
+  EXPECT_EQ(p.paper.ell_update, EllUpdate::kDescent);
+  EXPECT_DOUBLE_EQ(p.paper.color_ell, 0.1);
   EXPECT_EQ(p.odometry.initial_guess, InitialGuess::kIdentity);
   EXPECT_EQ(p.odometry.threads, 2);
-  EXPECT_DOUBLE_EQ(p.solver.ell_init, Params().solver.ell_init);
+  EXPECT_DOUBLE_EQ(p.paper.ell_init, Params().paper.ell_init);
   // An empty text keeps the base.
   EXPECT_EQ(flatten(parseParams("", p)), flatten(p));
 }
 
 TEST(Params, UnknownKeyIsRejectedByName) {
-  const std::string msg = expectThrowMessage("solver:\n  ell_initial: 0.1\n");
-  EXPECT_NE(msg.find("solver.ell_initial"), std::string::npos) << msg;
+  const std::string msg = expectThrowMessage("paper:\n  ell_initial: 0.1\n");
+  EXPECT_NE(msg.find("paper.ell_initial"), std::string::npos) << msg;
   EXPECT_NE(msg.find("test.yaml"), std::string::npos) << msg;
   // A key of another section is unknown in this one.
   const std::string other = expectThrowMessage("selection:\n  sigma: 0.1\n");
   EXPECT_NE(other.find("selection.sigma"), std::string::npos) << other;
+  // One engine's knob is unknown to the other's section.
+  const std::string engine = expectThrowMessage("coarse_to_fine:\n  ell_max: 0.1\n");
+  EXPECT_NE(engine.find("coarse_to_fine.ell_max"), std::string::npos) << engine;
 }
 
 TEST(Params, UnknownSectionIsRejectedByName) {
@@ -153,25 +179,28 @@ TEST(Params, WrongTypesAreRejectedByName) {
       {"selection:\n  target_points: lots\n", "selection.target_points"},
       {"selection:\n  target_points: 2.5\n", "selection.target_points"},
       {"selection:\n  canny_fallback: 3\n", "selection.canny_fallback"},
-      {"solver:\n  sigma: abc\n", "solver.sigma"},
-      {"solver:\n  sigma: [0.1, 0.2]\n", "solver.sigma"},
-      {"solver:\n  ell_policy: sideways\n", "solver.ell_policy"},
+      {"coarse_to_fine:\n  sigma: abc\n", "coarse_to_fine.sigma"},
+      {"paper:\n  sigma: [0.1, 0.2]\n", "paper.sigma"},
+      {"paper:\n  ell_policy: sideways\n", "paper.ell_policy"},
+      {"registration:\n  engine: icp\n", "registration.engine"},
       {"odometry:\n  initial_guess: 1\n", "odometry.initial_guess"},
-      {"solver: 3\n", "solver"},
+      {"paper: 3\n", "paper"},
       {"- a\n- b\n", "sections"},
   };
   for (const auto& [yaml, key] : cases) {
     const std::string msg = expectThrowMessage(yaml);
     EXPECT_NE(msg.find(key), std::string::npos) << yaml << " -> " << msg;
   }
-  const std::string msg = expectThrowMessage("solver:\n  ell_policy: sideways\n");
+  const std::string msg = expectThrowMessage("paper:\n  ell_policy: sideways\n");
   EXPECT_NE(msg.find("fixed_schedule"), std::string::npos) << "accepted values listed: " << msg;
+  const std::string engine = expectThrowMessage("registration:\n  engine: icp\n");
+  EXPECT_NE(engine.find("coarse_to_fine"), std::string::npos) << engine;
 }
 
 TEST(Params, LoadNamesTheFile) {
   const auto dir = test::tempDir("params");
   const std::string path = (dir / "bad.yaml").string();
-  std::ofstream(path) << "solver:\n  ell_min: 0.2\n  ell_max: 0.1\n";
+  std::ofstream(path) << "paper:\n  ell_min: 0.2\n  ell_max: 0.1\n";
   try {
     loadParams(path);
     ADD_FAILURE() << "inconsistent file accepted";
@@ -188,7 +217,7 @@ TEST(Params, LoadNamesTheFile) {
     EXPECT_NE(std::string(e.what()).find(missing), std::string::npos) << e.what();
   }
   const std::string broken = (dir / "broken.yaml").string();
-  std::ofstream(broken) << "solver: [unclosed\n";
+  std::ofstream(broken) << "paper: [unclosed\n";
   EXPECT_THROW(loadParams(broken), std::runtime_error);
 }
 
@@ -224,6 +253,13 @@ TEST(Params, EnumStringsRoundTrip) {
   EXPECT_EQ(toString(Reference::kPreviousFrame), "previous_frame");
   EXPECT_EQ(toString(SearchDirection::kConjugateGradient), "conjugate_gradient");
   EXPECT_EQ(toString(SearchDirection::kGradient), "gradient");
+  for (Engine v : {Engine::kCoarseToFine, Engine::kPaper}) {
+    Engine back = v == Engine::kPaper ? Engine::kCoarseToFine : Engine::kPaper;
+    fromString(toString(v), back);
+    EXPECT_EQ(back, v);
+  }
+  EXPECT_EQ(toString(Engine::kCoarseToFine), "coarse_to_fine");
+  EXPECT_EQ(toString(Engine::kPaper), "paper");
   EXPECT_EQ(toString(EllPolicy::kAdaptive), "adaptive");
   EXPECT_EQ(toString(EllPolicy::kFixedSchedule), "fixed_schedule");
   EXPECT_EQ(toString(EllUpdate::kDescent), "descent");
@@ -242,10 +278,19 @@ TEST(Params, ValidateCatchesInconsistentValues) {
     change(p);
     return validate(p);
   };
-  EXPECT_NE(message([](Params& p) { p.solver.ell_min = 0.2; }).find("ell_min"), std::string::npos);
-  EXPECT_NE(message([](Params& p) { p.solver.sigma = 0.0; }).find("sigma"), std::string::npos);
-  EXPECT_NE(message([](Params& p) { p.solver.sigma = -0.1; }).find("sigma"), std::string::npos);
-  EXPECT_NE(message([](Params& p) { p.solver.color_sigma = 0.0; }).find("color_sigma"),
+  EXPECT_NE(message([](Params& p) { p.paper.ell_min = 0.2; }).find("paper.ell_min"),
+            std::string::npos);
+  EXPECT_NE(message([](Params& p) { p.coarse_to_fine.ell_min = 0.2; })
+                .find("coarse_to_fine.ell_init"),
+            std::string::npos);
+  EXPECT_NE(message([](Params& p) { p.coarse_to_fine.sigma = 0.0; }).find("coarse_to_fine.sigma"),
+            std::string::npos);
+  EXPECT_NE(message([](Params& p) { p.paper.sigma = -0.1; }).find("paper.sigma"),
+            std::string::npos);
+  EXPECT_NE(message([](Params& p) { p.paper.color_sigma = 0.0; }).find("color_sigma"),
+            std::string::npos);
+  EXPECT_NE(message([](Params& p) { p.coarse_to_fine.level_acceleration = 1.0; })
+                .find("level_acceleration"),
             std::string::npos);
   EXPECT_NE(message([](Params& p) { p.selection.target_points = 0; }).find("target_points"),
             std::string::npos);
@@ -256,10 +301,10 @@ TEST(Params, ValidateCatchesInconsistentValues) {
   EXPECT_NE(message([](Params& p) { p.selection.min_depth = 7.0; }).find("min_depth"),
             std::string::npos);
   EXPECT_NE(message([](Params& p) {
-              p.solver.ell_init = std::numeric_limits<double>::quiet_NaN();
-            }).find("solver.ell_init"),
+              p.paper.ell_init = std::numeric_limits<double>::quiet_NaN();
+            }).find("paper.ell_init"),
             std::string::npos);
-  EXPECT_NE(message([](Params& p) { p.solver.max_step = 0.1; }).find("min_step"),
+  EXPECT_NE(message([](Params& p) { p.paper.max_step = 0.1; }).find("min_step"),
             std::string::npos);
   EXPECT_NE(message([](Params& p) { p.odometry.threads = -1; }).find("threads"), std::string::npos);
   EXPECT_NE(message([](Params& p) { p.odometry.keyframe_matched_fraction = 1.5; })
@@ -271,8 +316,8 @@ TEST(Params, ValidateCatchesInconsistentValues) {
   EXPECT_NE(message([](Params& p) { p.odometry.lost_speed = -1.0; }).find("odometry.lost_speed"),
             std::string::npos);
   // The YAML loader applies the same checks.
-  const std::string msg = expectThrowMessage("solver:\n  sigma: -1\n");
-  EXPECT_NE(msg.find("solver.sigma"), std::string::npos) << msg;
+  const std::string msg = expectThrowMessage("coarse_to_fine:\n  sigma: -1\n");
+  EXPECT_NE(msg.find("coarse_to_fine.sigma"), std::string::npos) << msg;
 }
 
 }  // namespace

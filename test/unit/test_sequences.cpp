@@ -1,11 +1,12 @@
 // Whole sequences: RPE over 1 s on synthetic 300-frame sequences (Kinect-like noise) in the
 // TUM structure/texture conditions and on the shared real Kinect frames, for the default engine
-// (coarse_to_fine) and the paper's two policies (paperParams()). Bounds are the measured
-// figures with a margin (docs/accuracy.md).
+// (coarse_to_fine) and the paper's A-CVO and CVO (paperParams(), cvoParams()). Bounds are the
+// measured figures with a margin (docs/accuracy.md).
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <ostream>
 #include <utility>
 #include <vector>
 
@@ -27,17 +28,15 @@ struct PolicyRun {
   std::vector<Tracking> tracking;  // the engine's judgement of each frame
 };
 
-// Runs odometry with each policy over the same frames (rendered once); frame i is compared
+// Runs odometry with each setting over the same frames (rendered once); frame i is compared
 // with groundtruth[i].
 template <std::size_t N, typename FrameAt>
-std::array<PolicyRun, N> runPolicies(const std::array<EllPolicy, N>& policies, int frames,
+std::array<PolicyRun, N> runPolicies(const std::array<Params, N>& settings, int frames,
                                      FrameAt frame_at, const Trajectory& groundtruth) {
   std::array<PolicyRun, N> runs;
   std::array<Odometry, N> odo;
   for (std::size_t p = 0; p < N; ++p) {
-    Params params = policies[p] == EllPolicy::kCoarseToFine ? Params() : paperParams();
-    params.solver.ell_policy = policies[p];
-    odo[p] = Odometry(params);
+    odo[p] = Odometry(settings[p]);
     odo[p].reset(groundtruth.front().pose);
   }
   for (int i = 0; i < frames; ++i) {
@@ -56,8 +55,7 @@ std::array<PolicyRun, N> runPolicies(const std::array<EllPolicy, N>& policies, i
 // The default engine, then the paper's adaptive and fixed-schedule policies.
 template <typename FrameAt>
 std::array<PolicyRun, 3> runAll(int frames, FrameAt frame_at, const Trajectory& groundtruth) {
-  return runPolicies<3>({EllPolicy::kCoarseToFine, EllPolicy::kAdaptive, EllPolicy::kFixedSchedule},
-                        frames, frame_at, groundtruth);
+  return runPolicies<3>({Params(), paperParams(), cvoParams()}, frames, frame_at, groundtruth);
 }
 const char* const kRunNames[] = {"coarse_to_fine", "adaptive", "fixed_schedule"};
 
@@ -76,6 +74,10 @@ struct Condition {
   double max_trans, max_rot_deg;      // bounds for the default engine (m/s, deg/s)
   double paper_trans, paper_rot_deg;  // bounds for the paper's adaptive policy
 };
+
+void PrintTo(const Condition& c, std::ostream* os) {
+  *os << "structure " << (c.structure ? "on" : "off") << ", texture " << (c.texture ? "on" : "off");
+}
 
 class Sequences : public ::testing::TestWithParam<Condition> {};
 
@@ -100,8 +102,7 @@ TEST_P(Sequences, RpeOverOneSecondOnASyntheticSequence) {
   EXPECT_LT(runs[1].rpe.trans.rmse, c.paper_trans);
   EXPECT_LT(runs[1].rpe.rot_deg.rmse, c.paper_rot_deg);
   // The adaptive length-scale is what A-CVO adds: it must not do noticeably worse than CVO's
-  // schedule. Measured: better in both on the rooms (by 1.5-2x); on the textured plane the two
-  // are level (0.0044 vs 0.0045 m/s, 0.166 vs 0.153 deg/s).
+  // schedule. Measured: better in both on the rooms (by 2x); on the textured plane by 10-20%.
   EXPECT_LE(runs[1].rpe.trans.rmse, 1.15 * runs[2].rpe.trans.rmse);
   EXPECT_LE(runs[1].rpe.rot_deg.rmse, 1.15 * runs[2].rpe.rot_deg.rmse);
   // The default engine is no worse than the paper's on any condition (issue: within 10%).
@@ -115,11 +116,12 @@ TEST_P(Sequences, RpeOverOneSecondOnASyntheticSequence) {
 INSTANTIATE_TEST_SUITE_P(StructureTexture, Sequences,
                          // Measured, default engine (keyframes): 0.0025/0.062,
                          // 0.0055/0.154, 0.0013/0.042 (frame to frame it was 0.0078/0.208,
-                         // 0.0129/0.300, 0.0032/0.174); paper's adaptive: 0.0090/0.251,
-                         // 0.0132/0.381, 0.0044/0.166.
-                         ::testing::Values(Condition{true, true, 0.004, 0.1, 0.015, 0.45},
-                                           Condition{true, false, 0.008, 0.23, 0.03, 0.8},
-                                           Condition{false, true, 0.002, 0.065, 0.01, 0.35}),
+                         // 0.0129/0.300, 0.0032/0.174); paper.yaml (the authors' settings):
+                         // 0.0151/0.423, 0.0438/0.987, 0.0052/0.184; cvo.yaml 0.0344/0.862,
+                         // 0.0805/1.799, 0.0058/0.232.
+                         ::testing::Values(Condition{true, true, 0.004, 0.1, 0.018, 0.51},
+                                           Condition{true, false, 0.008, 0.23, 0.053, 1.19},
+                                           Condition{false, true, 0.002, 0.065, 0.0063, 0.22}),
                          [](const auto& info) {
                            return std::string("structure_") +
                                   (info.param.structure ? "on" : "off") + "_texture_" +
@@ -174,7 +176,7 @@ TEST(Sequences, EveryOtherFrameMissingStillTracks) {
   Trajectory gt;  // the frames that arrive: 15 Hz, twice the motion per registration
   for (int i = 0; i < seq.size(); i += 2) gt.push_back(all[i]);
   const PolicyRun run = runPolicies<1>(
-      {EllPolicy::kCoarseToFine}, int(gt.size()), [&](int i) { return seq.frame(2 * i).toFrame(); },
+      {Params()}, int(gt.size()), [&](int i) { return seq.frame(2 * i).toFrame(); },
       gt)[0];
   std::printf("  every other frame missing: RPE %.4f m/s %.3f deg/s (%zu pairs), %d lost\n",
               run.rpe.trans.rmse, run.rpe.rot_deg.rmse, run.rpe.pairs, run.lost);
@@ -204,7 +206,7 @@ void runBlackout(Blank kind) {
     }
     return f;
   };
-  const PolicyRun run = runPolicies<1>({EllPolicy::kCoarseToFine}, kFrames, frame_at, gt)[0];
+  const PolicyRun run = runPolicies<1>({Params()}, kFrames, frame_at, gt)[0];
   const Trajectory& est = run.estimate;
   EXPECT_TRUE(allFinite(est));
   for (int i = 0; i < kStart; ++i) EXPECT_NE(run.tracking[i], Tracking::kLost) << "frame " << i;
@@ -273,24 +275,24 @@ TEST(Sequences, RpeOnRealKinectFrames) {
     std::printf("  kitchen7s_dev %-14s RPE %.4f m/s %.3f deg/s, %d lost\n", kRunNames[p],
                 runs[p].rpe.trans.rmse, runs[p].rpe.rot_deg.rmse, runs[p].lost);
   }
-  // Measured 0.0315 m/s, 3.12 deg/s (default; frame to frame 0.0336, 3.52), 0.064 m/s,
-  // 4.55 deg/s (paper's adaptive).
+  // Measured 0.0315 m/s, 3.12 deg/s (default; frame to frame 0.0336, 3.52); paper.yaml 0.0631
+  // m/s, 4.49 deg/s; cvo.yaml 0.0893, 5.47.
   // 7-Scenes colour and depth come from two unregistered cameras: the labels sit beside their
   // points, which costs accuracy here.
   EXPECT_EQ(runs[0].lost, 0);
   EXPECT_LT(runs[0].rpe.trans.rmse, 0.034);
   EXPECT_LT(runs[0].rpe.rot_deg.rmse, 3.4);
   EXPECT_EQ(runs[1].lost, 0);
-  EXPECT_LT(runs[1].rpe.trans.rmse, 0.08);
-  EXPECT_LT(runs[1].rpe.rot_deg.rmse, 5.5);
+  EXPECT_LT(runs[1].rpe.trans.rmse, 0.07);
+  EXPECT_LT(runs[1].rpe.rot_deg.rmse, 5.0);
+  EXPECT_EQ(runs[2].lost, 0);
 }
 
 // TUM fr3/teddy (200 frames, hand-held, up to 100 deg/s) with motion-capture ground truth: the
-// default engine against the bounds OpenCV's RgbdOdometry reaches on the same frames
-// (acvo_compare: 0.0252 m/s, 1.49 deg/s), nothing lost, and well below the drift of the same
-// engine registering frame to frame; the paper's A-CVO shrinks the motion there (measured
-// 0.0973 m/s, 7.48 deg/s; docs/accuracy.md).
-TEST(Sequences, RealHandHeldMotionMatchesDenseRgbdOdometry) {
+// default engine within a margin of its measured figures, nothing lost, and well below the
+// drift of the same engine registering frame to frame. (OpenCV's RgbdOdometry set up as its
+// TUM sample, at 10 m, does better here: 0.0104 m/s, 0.496 deg/s; docs/accuracy.md.)
+TEST(Sequences, RealHandHeldMotionIsTrackedWithoutLossOrDrift) {
   const auto shared = test::sharedDataDir();
   if (shared.empty()) GTEST_SKIP() << "../shared/data not present";
   const TumDataset data((shared / "tum_fr3_teddy200").string());
@@ -327,10 +329,51 @@ TEST(Sequences, RealHandHeldMotionMatchesDenseRgbdOdometry) {
       rpe.trans.rmse, rpe.rot_deg.rmse, ate, ate_previous, lost[0]);
   // Measured 0.0159 m/s, 1.066 deg/s; ATE 0.0185 m against 0.0312 m frame to frame.
   EXPECT_EQ(lost[0], 0);
-  EXPECT_LT(rpe.trans.rmse, 0.0252);
-  EXPECT_LT(rpe.rot_deg.rmse, 1.49);
+  EXPECT_LT(rpe.trans.rmse, 0.0175);
+  EXPECT_LT(rpe.rot_deg.rmse, 1.17);
   // Keyframes against drift: at most 0.7 of the frame-to-frame ATE (the issue's target).
   EXPECT_LT(ate, 0.7 * ate_previous);
+}
+
+// The paper's A-CVO (config/paper.yaml) and CVO (config/cvo.yaml) against the authors' public
+// code, built and run on the same 193 teddy frames: A-CVO 0.0957 m/s, 5.78 deg/s; CVO 0.111 m/s,
+// 6.45 deg/s. Each must be within 5% of those in both, nothing lost.
+TEST(Sequences, PaperConfigsReproduceTheAuthorsCodeOnTeddy) {
+  const auto shared = test::sharedDataDir();
+  if (shared.empty()) GTEST_SKIP() << "../shared/data not present";
+  const TumDataset data((shared / "tum_fr3_teddy200").string());
+  ASSERT_TRUE(data.groundtruth());
+  const Trajectory& gt = *data.groundtruth();
+  const double t0 = data.frames().front().rgb.stamp;
+  const auto nearest = std::min_element(gt.begin(), gt.end(), [t0](const auto& a, const auto& b) {
+    return std::abs(a.stamp - t0) < std::abs(b.stamp - t0);
+  });
+  std::array<Odometry, 2> odo = {Odometry(paperParams()), Odometry(cvoParams())};
+  std::array<Trajectory, 2> est;
+  std::array<int, 2> lost = {0, 0};
+  for (int k = 0; k < 2; ++k) odo[k].reset(nearest->pose);
+  for (std::size_t i = 0; i < data.size(); ++i) {
+    const Frame frame = data.loadFrame(i);
+    const auto& e = data.frames()[i].rgb;
+    for (int k = 0; k < 2; ++k) {
+      const OdometryResult r = odo[k].process(frame);
+      lost[k] += r.tracking == Tracking::kLost;
+      est[k].push_back({e.stamp_text, e.stamp, r.pose});
+    }
+  }
+  const char* names[] = {"paper.yaml (A-CVO)", "cvo.yaml (CVO)"};
+  const double authors[2][2] = {{0.0957, 5.78}, {0.111, 6.45}};
+  for (int k = 0; k < 2; ++k) {
+    const RpeResult rpe = computeRpe(gt, est[k]);
+    const double rt = rpe.trans.rmse / authors[k][0], rr = rpe.rot_deg.rmse / authors[k][1];
+    std::printf("  tum_fr3_teddy200 %-18s RPE %.4f m/s %.3f deg/s (%.3f / %.3f of the authors' "
+                "code), %d lost\n",
+                names[k], rpe.trans.rmse, rpe.rot_deg.rmse, rt, rr, lost[k]);
+    // Measured: A-CVO 0.0955 / 5.943 (0.998 / 1.028); CVO 0.1068 / 6.164 (0.962 / 0.956).
+    EXPECT_EQ(lost[k], 0) << names[k];
+    EXPECT_NEAR(rt, 1.0, 0.05) << names[k];
+    EXPECT_NEAR(rr, 1.0, 0.05) << names[k];
+  }
 }
 
 // Lost means lost: a camera turning at more than 90 deg/s (rotation about each axis in turn,
@@ -348,7 +391,7 @@ TEST(Sequences, FastRotationIsNeverLost) {
   const double mean_speed = angle / (seq.stamp(seq.size() - 1) - seq.stamp(0));
   ASSERT_GE(mean_speed, 90.0);
   const PolicyRun run = runPolicies<1>(
-      {EllPolicy::kCoarseToFine}, seq.size(), [&](int i) { return seq.frame(i).toFrame(); }, gt)[0];
+      {Params()}, seq.size(), [&](int i) { return seq.frame(i).toFrame(); }, gt)[0];
   std::printf("  rotation at %.0f deg/s: RPE %.4f m/s %.3f deg/s, %d lost\n", mean_speed,
               run.rpe.trans.rmse, run.rpe.rot_deg.rmse, run.lost);
   EXPECT_EQ(run.lost, 0);

@@ -1,11 +1,12 @@
-// Solver formulas against independent computations (docs/method.md §3, §4).
+// The paper engine's formulas against independent computations (docs/method.md §3, §4), and
+// the default engine's step extrapolation.
 #include <gtest/gtest.h>
 
 #include <iostream>
 
-#include "acvo/cross_kernel.hpp"
+#include "acvo/registration/coarse_to_fine.hpp"
+#include "acvo/registration/paper.hpp"
 #include "acvo/se3.hpp"
-#include "acvo/solver.hpp"
 #include "cloud_fixtures.hpp"
 
 namespace acvo {
@@ -41,12 +42,14 @@ TEST(StepSize, DegenerateLeadingTermsAndNoRoot) {
 }
 
 TEST(FixedSchedule, LengthScalesOfTheOriginalCvo) {
+  // The authors' code switches after iterations 3, 10 and 20.
   EXPECT_EQ(scheduledEll(0), 0.15);
-  EXPECT_EQ(scheduledEll(1), 0.15);
-  EXPECT_EQ(scheduledEll(2), 0.10);
-  EXPECT_EQ(scheduledEll(8), 0.10);
-  EXPECT_EQ(scheduledEll(9), 0.06);
-  EXPECT_EQ(scheduledEll(19), 0.03);
+  EXPECT_EQ(scheduledEll(3), 0.15);
+  EXPECT_EQ(scheduledEll(4), 0.10);
+  EXPECT_EQ(scheduledEll(10), 0.10);
+  EXPECT_EQ(scheduledEll(11), 0.06);
+  EXPECT_EQ(scheduledEll(20), 0.06);
+  EXPECT_EQ(scheduledEll(21), 0.03);
   EXPECT_EQ(scheduledEll(500), 0.03);
 }
 
@@ -63,17 +66,17 @@ Pair offsetPair(unsigned seed, const Vector6d& motion_twist) {
 }
 
 // A sparsification so small that no pair in these clouds is dropped: F is smooth.
-SolverParams denseParams() {
-  SolverParams p = paperParams().solver;
+PaperParams denseParams() {
+  PaperParams p = paperParams().paper;
   p.sparsification = 1e-30;
   return p;
 }
 
 TEST(Gradient, MatchesFiniteDifferenceOfTheObjective) {
-  const SolverParams p = denseParams();
+  const PaperParams p = denseParams();
   const Pair pr = offsetPair(11, (Vector6d() << 0.03, -0.02, 0.01, 0.03, 0.02, -0.01).finished());
-  const PreparedCloud fx = prepareCloud(pr.X, p), mz = prepareCloud(pr.Z, p);
-  CrossKernel kernel(fx, mz, p);
+  const auto fx = preparePaper(pr.X, p, true), mz = preparePaper(pr.Z, p, false);
+  PaperKernel kernel(fx->cloud, mz->cloud, fx->grid, p);
   const double ell = 0.1;
   const CrossSums s = kernel.evaluate(Eigen::Isometry3d::Identity(), ell);
   // dF/dxi for y -> exp(xi^) y equals -(c/l^2) omega and -(d/l^2) v.
@@ -91,10 +94,10 @@ TEST(Gradient, MatchesFiniteDifferenceOfTheObjective) {
 }
 
 TEST(StepSums, BIsTheDerivativeAlongTheFlow) {
-  const SolverParams p = denseParams();
+  const PaperParams p = denseParams();
   const Pair pr = offsetPair(12, (Vector6d() << -0.02, 0.03, 0.02, -0.02, 0.03, 0.02).finished());
-  const PreparedCloud fx = prepareCloud(pr.X, p), mz = prepareCloud(pr.Z, p);
-  CrossKernel kernel(fx, mz, p);
+  const auto fx = preparePaper(pr.X, p, true), mz = preparePaper(pr.Z, p, false);
+  PaperKernel kernel(fx->cloud, mz->cloud, fx->grid, p);
   const double ell = 0.1;
   const CrossSums s = kernel.evaluate(Eigen::Isometry3d::Identity(), ell);
   const StepSums st = kernel.stepSums(s.omega, s.v);
@@ -108,10 +111,10 @@ TEST(StepSums, BIsTheDerivativeAlongTheFlow) {
 }
 
 TEST(StepSums, CDEAreTheTaylorCoefficientsOfTheObjective) {
-  const SolverParams p = denseParams();
+  const PaperParams p = denseParams();
   const Pair pr = offsetPair(14, (Vector6d() << 0.02, -0.03, 0.01, 0.03, 0.01, -0.02).finished());
-  const PreparedCloud fx = prepareCloud(pr.X, p), mz = prepareCloud(pr.Z, p);
-  CrossKernel kernel(fx, mz, p);
+  const auto fx = preparePaper(pr.X, p, true), mz = preparePaper(pr.Z, p, false);
+  PaperKernel kernel(fx->cloud, mz->cloud, fx->grid, p);
   const double ell = 0.1;
   const CrossSums s = kernel.evaluate(Eigen::Isometry3d::Identity(), ell);
   const StepSums st = kernel.stepSums(s.omega, s.v);
@@ -131,10 +134,10 @@ TEST(StepSums, CDEAreTheTaylorCoefficientsOfTheObjective) {
 }
 
 TEST(LengthScale, GradientMatchesCentralDifferenceOfJ) {
-  const SolverParams p = denseParams();
+  const PaperParams p = denseParams();
   const Pair pr = offsetPair(13, (Vector6d() << 0.01, 0.02, -0.01, 0.02, -0.01, 0.01).finished());
-  const PreparedCloud fx = prepareCloud(pr.X, p), mz = prepareCloud(pr.Z, p);
-  CrossKernel kernel(fx, mz, p);
+  const auto fx = preparePaper(pr.X, p, true), mz = preparePaper(pr.Z, p, false);
+  PaperKernel kernel(fx->cloud, mz->cloud, fx->grid, p);
   auto J = [&](double ell) {
     const auto I = Eigen::Isometry3d::Identity();
     return test::bruteForce(pr.X, pr.X, I, ell, p).F + test::bruteForce(pr.Z, pr.Z, I, ell, p).F -
@@ -142,7 +145,7 @@ TEST(LengthScale, GradientMatchesCentralDifferenceOfJ) {
   };
   for (double ell : {0.05, 0.1, 0.14}) {
     const CrossSums s = kernel.evaluate(Eigen::Isometry3d::Identity(), ell);
-    const SelfSums xx = selfKernelSums(fx, ell, p), yy = selfKernelSums(mz, ell, p);
+    const SelfSums xx = selfKernelSums(*fx, ell, p), yy = selfKernelSums(*mz, ell, p);
     const double analytic = (xx.sum_d2 + yy.sum_d2 - 2 * s.F_d2) / (ell * ell * ell);
     const double h = 1e-5;
     const double numeric = (J(ell + h) - J(ell - h)) / (2 * h);
@@ -195,7 +198,8 @@ TEST(Extrapolation, ExtendsShrinkingAlignedStepsOnly) {
 // The length-scale update of A-CVO: descent along dJ/dell, the bound shrinking on contact and
 // never below ell_min; ascent with the authors' sign.
 TEST(LengthScale, DescendsShrinksTheBoundOnContactAndStaysAboveTheMinimum) {
-  SolverParams p = paperParams().solver;  // ell_min 0.0391, ell_max 0.15, step 0.3, factor 0.7
+  PaperParams p = paperParams().paper;  // ell_min 0.0391, ell_max 0.15, step 0.3, factor 0.7
+  p.ell_update = EllUpdate::kDescent;
   LengthScale ls{0.1, p.ell_max};
   EXPECT_FALSE(updateLengthScale(ls, 0.05, p));  // 0.1 - 0.3 * 0.05
   EXPECT_DOUBLE_EQ(ls.ell, 0.085);
@@ -220,10 +224,16 @@ TEST(LengthScale, GradientIsNormalisedByThePairsThatEnterIt) {
   SelfSums xx, yy;
   CrossSums xy;
   xx.sum_d2 = 2.0, yy.sum_d2 = 3.0, xy.F_d2 = 1.0;
-  xx.nnz = 10, yy.nnz = 12, xy.nnz = 4;
+  // Every row counts in the normalisation, also rows left out of the sums (nnz_all).
+  xx.nnz = xx.nnz_all = 10, yy.nnz = 7, yy.nnz_all = 12, xy.nnz = 4;
   EXPECT_DOUBLE_EQ(lengthScaleGradient(xx, yy, xy, 0.5), (2.0 + 3.0 - 2.0) / 0.125 / 14.0);
-  xy.nnz = 20;  // a non-positive count leaves the sum as it is
+  xy.nnz = 20;  // descent: a non-positive count leaves the sum as it is
   EXPECT_DOUBLE_EQ(lengthScaleGradient(xx, yy, xy, 0.5), 3.0 / 0.125);
+  // reference (the authors' code) divides by any non-zero count, negative included.
+  EXPECT_DOUBLE_EQ(lengthScaleGradient(xx, yy, xy, 0.5, EllUpdate::kReference),
+                   3.0 / 0.125 / -18.0);
+  xy.nnz = 11;
+  EXPECT_DOUBLE_EQ(lengthScaleGradient(xx, yy, xy, 0.5, EllUpdate::kReference), 3.0 / 0.125);
 }
 
 TEST(StallRule, StopsAfterPatienceIterationsWithoutABetterObjectiveAtOneLengthScale) {
@@ -263,15 +273,16 @@ TEST(SearchState, GradientFirstThenConjugate) {
 }
 
 TEST(Align, IdenticalCloudsGiveIdentityInZeroIterations) {
-  SolverParams p = paperParams().solver;
+  PaperParams p = paperParams().paper;
   const LabelledCloud X = test::randomCloud(1500, 21, 0.5f);
-  const PreparedCloud fx = prepareCloud(X, p), mz = prepareCloud(X, p);
-  const CrossSums s = CrossKernel(fx, mz, p).evaluate(Eigen::Isometry3d::Identity(), 0.1);
+  const auto fx = preparePaper(X, p, true), mz = preparePaper(X, p, false);
+  const CrossSums s =
+      PaperKernel(fx->cloud, mz->cloud, fx->grid, p).evaluate(Eigen::Isometry3d::Identity(), 0.1);
   EXPECT_LT(s.omega.norm(), 1e-9);
   EXPECT_LT(s.v.norm(), 1e-9);
   for (EllPolicy policy : {EllPolicy::kAdaptive, EllPolicy::kFixedSchedule}) {
     p.ell_policy = policy;
-    const SolverResult r = align(fx, mz, Eigen::Isometry3d::Identity(), p);
+    const SolverResult r = alignPaper(*fx, *mz, Eigen::Isometry3d::Identity(), p);
     EXPECT_EQ(r.status, SolverStatus::kConverged);
     EXPECT_EQ(r.iterations, 0);
     EXPECT_TRUE(r.transform.isApprox(Eigen::Isometry3d::Identity(), 1e-15));
@@ -286,15 +297,15 @@ TEST(Align, RecoversSmallMotionsOfARandomSurfaceCloud) {
       (Vector6d() << 0.03, 0.02, -0.04, -0.03, 0.02, 0.025).finished(),  // both
   };
   for (EllPolicy policy : {EllPolicy::kAdaptive, EllPolicy::kFixedSchedule}) {
-    SolverParams p = paperParams().solver;
+    PaperParams p = paperParams().paper;
     p.ell_policy = policy;
     p.max_iterations = 500;
     for (const auto& m : motions) {
       const Eigen::Isometry3d truth = expSE3(m);
       const LabelledCloud X = test::randomCloud(3000, 31, 0.6f);
       const LabelledCloud Z = test::transformed(X, truth.inverse());
-      const PreparedCloud fx = prepareCloud(X, p), mz = prepareCloud(Z, p);
-      const SolverResult r = align(fx, mz, Eigen::Isometry3d::Identity(), p);
+      const auto fx = preparePaper(X, p, true), mz = preparePaper(Z, p, false);
+      const SolverResult r = alignPaper(*fx, *mz, Eigen::Isometry3d::Identity(), p);
       const Vector6d err = logSE3(truth.inverse() * r.transform);
       EXPECT_LT(err.tail<3>().norm(), 1e-3)
           << "policy " << int(policy) << " iterations " << r.iterations;
@@ -308,15 +319,15 @@ TEST(Align, ConjugateGradientReachesTheSameOptimumInFewerIterations) {
   // slab of points (the random cloud's surface is thin in z) plus a rotation about its normal.
   const Vector6d m = (Vector6d() << 0.0, 0.0, 0.04, 0.04, -0.03, 0.0).finished();
   const Eigen::Isometry3d truth = expSE3(m);
-  SolverParams p = paperParams().solver;
+  PaperParams p = paperParams().paper;
   p.max_iterations = 500;
   const LabelledCloud X = test::randomCloud(3000, 41, 0.6f);
   const LabelledCloud Z = test::transformed(X, truth.inverse());
-  const PreparedCloud fx = prepareCloud(X, p), mz = prepareCloud(Z, p);
+  const auto fx = preparePaper(X, p, true), mz = preparePaper(Z, p, false);
   p.direction = SearchDirection::kGradient;
-  const SolverResult grad = align(fx, mz, Eigen::Isometry3d::Identity(), p);
+  const SolverResult grad = alignPaper(*fx, *mz, Eigen::Isometry3d::Identity(), p);
   p.direction = SearchDirection::kConjugateGradient;
-  const SolverResult cg = align(fx, mz, Eigen::Isometry3d::Identity(), p);
+  const SolverResult cg = alignPaper(*fx, *mz, Eigen::Isometry3d::Identity(), p);
   ASSERT_EQ(grad.status, SolverStatus::kConverged);
   ASSERT_EQ(cg.status, SolverStatus::kConverged);
   for (const SolverResult* r : {&grad, &cg}) {
@@ -332,15 +343,15 @@ TEST(Align, ConjugateGradientReachesTheSameOptimumInFewerIterations) {
 }
 
 TEST(Align, LengthScaleStaysWithinBoundsAndEllMaxOnlyShrinks) {
-  SolverParams p = paperParams().solver;
+  PaperParams p = paperParams().paper;
   p.max_iterations = 300;
   const LabelledCloud X = test::randomCloud(2000, 41, 0.6f);
   const LabelledCloud Z =
       test::transformed(X, expSE3((Vector6d() << 0.05, 0, 0.02, 0.05, 0.03, 0).finished()));
-  const PreparedCloud fx = prepareCloud(X, p), mz = prepareCloud(Z, p);
+  const auto fx = preparePaper(X, p, true), mz = preparePaper(Z, p, false);
   for (EllUpdate update : {EllUpdate::kDescent, EllUpdate::kReference}) {
     p.ell_update = update;
-    const SolverResult r = align(fx, mz, Eigen::Isometry3d::Identity(), p);
+    const SolverResult r = alignPaper(*fx, *mz, Eigen::Isometry3d::Identity(), p);
     ASSERT_FALSE(r.trace.empty());
     EXPECT_EQ(r.trace.front().ell, p.ell_init) << "ell starts from ell_init for every frame";
     double last_max = p.ell_max;
@@ -353,26 +364,31 @@ TEST(Align, LengthScaleStaysWithinBoundsAndEllMaxOnlyShrinks) {
     EXPECT_GE(r.ell, p.ell_min);
     EXPECT_LE(r.ell, last_max);
     // A second registration starts again from the configured values.
-    const SolverResult again = align(fx, mz, Eigen::Isometry3d::Identity(), p);
+    const SolverResult again = alignPaper(*fx, *mz, Eigen::Isometry3d::Identity(), p);
     EXPECT_EQ(again.trace.front().ell, p.ell_init);
     EXPECT_EQ(again.iterations, r.iterations) << "registration is deterministic";
   }
 }
 
 TEST(Align, TooFewPointsAndNonFiniteInputGiveAStatusNotNaN) {
-  SolverParams p = paperParams().solver;
-  for (int n : {0, 1, 2}) {
-    const PreparedCloud c = prepareCloud(test::randomCloud(n, 5), p);
-    const SolverResult r = align(c, c, Eigen::Isometry3d::Identity(), p);
-    EXPECT_EQ(r.status, SolverStatus::kTooFewPoints);
+  // Both engines, through the interface the odometry uses.
+  for (Engine engine : {Engine::kPaper, Engine::kCoarseToFine}) {
+    Params params = paperParams();
+    params.registration.engine = engine;
+    const auto e = makeRegistrationEngine(params);
+    for (int n : {0, 1, 2}) {
+      const auto c = e->prepare(test::randomCloud(n, 5), true);
+      const SolverResult r = e->align(*c, *c, Eigen::Isometry3d::Identity());
+      EXPECT_EQ(r.status, SolverStatus::kTooFewPoints) << toString(engine);
+      EXPECT_TRUE(r.transform.matrix().allFinite());
+    }
+    const auto c = e->prepare(test::randomCloud(500, 5), true);
+    Eigen::Isometry3d bad = Eigen::Isometry3d::Identity();
+    bad.translation().x() = NAN;
+    const SolverResult r = e->align(*c, *c, bad);
+    EXPECT_EQ(r.status, SolverStatus::kNotFinite) << toString(engine);
     EXPECT_TRUE(r.transform.matrix().allFinite());
   }
-  const PreparedCloud c = prepareCloud(test::randomCloud(500, 5), p);
-  Eigen::Isometry3d bad = Eigen::Isometry3d::Identity();
-  bad.translation().x() = NAN;
-  const SolverResult r = align(c, c, bad, p);
-  EXPECT_EQ(r.status, SolverStatus::kNotFinite);
-  EXPECT_TRUE(r.transform.matrix().allFinite());
 }
 
 }  // namespace

@@ -1,3 +1,5 @@
+// The odometry pipeline (docs/method.md §7): each frame's cloud, its registration to the
+// keyframe, the pose and its covariance, the tracking judgement and the keyframe choice.
 #include "acvo/odometry.hpp"
 
 #include <chrono>
@@ -87,11 +89,7 @@ Judgement judgeTracking(const SolverResult& s, const Eigen::Isometry3d& frame_mo
             "weak overlap (" + percent(s.matched_fraction) + " of the points found a partner)"};
   }
   if (s.status == SolverStatus::kMaxIterations) return {Tracking::kHard, "iteration cap reached"};
-  if (s.ell_max_reductions >= params.hard_ell_reductions) {
-    return {Tracking::kHard, "length-scale kept reaching its upper bound (" +
-                                 std::to_string(s.ell_max_reductions) +
-                                 " reductions): weak structure"};
-  }
+  if (!s.hard.empty()) return {Tracking::kHard, s.hard};
   return {Tracking::kOk, ""};
 }
 
@@ -114,7 +112,7 @@ bool takesKeyframe(const Judgement& judgement, const SolverResult& s,
 
 bool replacesReference(const SolverResult& s, std::size_t points, std::size_t reference_points,
                        int lost_in_a_row, const Params& params) {
-  const std::size_t min_points = std::size_t(params.solver.min_points);
+  const std::size_t min_points = std::size_t(minPoints(params));
   if (points < min_points) return false;  // a blank frame never replaces the reference
   if (reference_points < min_points) return true;
   if (params.odometry.reference == Reference::kKeyframe) return lost_in_a_row >= 2;
@@ -130,6 +128,7 @@ bool replacesReference(const SolverResult& s, std::size_t points, std::size_t re
 
 Odometry::Odometry(const Params& params)
     : params_(params),
+      engine_(makeRegistrationEngine(params)),
       pose_covariance_(originCovariance()),
       arena_(std::make_unique<Arena>(params.odometry.threads)) {}
 Odometry::~Odometry() = default;
@@ -157,7 +156,7 @@ const LabelledCloud* Odometry::keyframeCloud() const {
 
 void Odometry::asReference(OdometryResult& r, PreparedCloud& cloud) {
   double ms = 0.0;
-  arena_->arena.execute([&] { ms = prepareReference(cloud, params_.solver); });
+  arena_->arena.execute([&] { ms = engine_->prepareReference(cloud); });
   r.ms_prepare += ms;
   r.ms_cloud += ms;
 }
@@ -166,8 +165,7 @@ Odometry::Registration Odometry::registerTo(const Tracked& reference, const Prep
                                             const Eigen::Isometry3d& guess) {
   Registration reg;
   reg.fixed_points = reference.cloud->size();
-  arena_->arena.execute(
-      [&] { reg.solver = align(*reference.cloud, current, guess, params_.solver); });
+  arena_->arena.execute([&] { reg.solver = engine_->align(*reference.cloud, current, guess); });
   // The motion limits hold per frame: from the last tracked frame, not from an older keyframe.
   const bool from_last = &reference == &*last_ || last_->index == reference.index;
   reg.judgement = judgeTracking(
@@ -181,8 +179,7 @@ Odometry::Registration Odometry::registerTo(const Tracked& reference, const Prep
   }
   if (reg.judgement.tracking == Tracking::kLost) return reg;
 
-  const std::optional<Matrix6d> cov =
-      motionCovariance(s, params_.solver, params_.odometry.covariance_scale, current.size());
+  const std::optional<Matrix6d> cov = engine_->covariance(s, current.size());
   if (!cov) {
     reg.covariance = lostCovariance();
     if (reg.judgement.tracking == Tracking::kOk) {
@@ -235,9 +232,8 @@ std::shared_ptr<PreparedCloud> Odometry::buildCloud(const Frame& frame, Odometry
   // With keyframes, only when it becomes one (asReference).
   const bool every_frame_a_reference = params_.odometry.reference == Reference::kPreviousFrame;
   arena_->arena.execute([&] {
-    current = std::make_shared<PreparedCloud>(
-        prepareCloud(buildLabelledCloud(frame, params_.selection, &r.cloud_stats), params_.solver,
-                     every_frame_a_reference));
+    current = engine_->prepare(buildLabelledCloud(frame, params_.selection, &r.cloud_stats),
+                               every_frame_a_reference);
   });
   r.ms_cloud = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
   r.moving_points = current->size();
@@ -267,7 +263,7 @@ Odometry::Registration Odometry::registerFrame(OdometryResult& r, const Prepared
 
   // Failed against the keyframe: the last tracked frame, closer in time, may still overlap.
   if (reg.judgement.tracking == Tracking::kLost && !last_is_keyframe &&
-      int(current.size()) >= params_.solver.min_points) {
+      int(current.size()) >= engine_->minPoints()) {
     asReference(r, *last_->cloud);
     Registration to_last = registerTo(*last_, current, prior);
     r.ms_registration += to_last.solver.ms_total;
@@ -284,7 +280,7 @@ Odometry::Registration Odometry::registerFrame(OdometryResult& r, const Prepared
   r.tracking = reg.judgement.tracking;
   r.message = reg.judgement.message;
   if (reg.solver.status == SolverStatus::kTooFewPoints) {
-    r.message += int(r.moving_points) < params_.solver.min_points
+    r.message += int(r.moving_points) < engine_->minPoints()
                      ? ": this frame has " + whyTooFewPoints(r.cloud_stats, params_.selection)
                      : ": the reference frame has too few points";
   }

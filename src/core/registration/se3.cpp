@@ -1,3 +1,4 @@
+// SE(3) exponential and logarithm in closed form, with small-angle series.
 #include "acvo/se3.hpp"
 
 #include <cmath>

@@ -1,3 +1,4 @@
+// TUM RGB-D folders: image lists, rgb/depth association, ground truth, trajectories.
 #include "acvo/tum.hpp"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// OpenCV's 8-bit HSV for single pixels: a cloud converts only its selected pixels.
 #include "acvo/hsv.hpp"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// What makes a frame unusable (Frame::problem): sizes, types, intrinsics, stamp.
 #include "acvo/frame.hpp"
 
 #include <sstream>

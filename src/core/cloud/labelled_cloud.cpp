@@ -1,3 +1,5 @@
+// A frame's labelled cloud (docs/method.md §1): selected pixels back-projected, with their
+// HSV and gradient labels and colours.
 #include "acvo/labelled_cloud.hpp"
 
 #include <chrono>

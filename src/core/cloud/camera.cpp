@@ -1,3 +1,4 @@
+// Pinhole intrinsics: validity, the TUM cameras by name (fr1, fr2, fr3), camera.yaml read/write.
 #include "acvo/camera.hpp"
 
 #include <cmath>

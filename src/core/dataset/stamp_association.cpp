@@ -1,3 +1,4 @@
+// Nearest-stamp association of two sorted stamp lists within a tolerance (TUM's associate.py).
 #include "stamp_association.hpp"
 
 #include <algorithm>

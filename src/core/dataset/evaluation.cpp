@@ -1,3 +1,4 @@
+// RPE and ATE as the TUM RGB-D benchmark tools compute them (docs/method.md §8).
 #include "acvo/evaluation.hpp"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// Covariances of motions and poses (docs/method.md §7).
 #include "acvo/covariance.hpp"
 
 #include <algorithm>
@@ -5,7 +6,6 @@
 
 #include <Eigen/Eigenvalues>
 
-#include "acvo/solver.hpp"
 
 namespace acvo {
 
@@ -21,10 +21,7 @@ Matrix6d sanitiseCovariance(const Matrix6d& c) {
   return 0.5 * (c + c.transpose());
 }
 
-std::optional<Matrix6d> motionCovariance(const SolverResult& s, const SolverParams& solver,
-                                         double covariance_scale, std::size_t moving_points) {
-  // The curvature is negative definite at a maximum: its negative is the information.
-  const Matrix6d info = -s.hessian;
+std::optional<Matrix6d> scaledInverseInformation(const Matrix6d& info, double covariance_scale) {
   Eigen::SelfAdjointEigenSolver<Matrix6d> eig(0.5 * (info + info.transpose()));
   Vector6d lambda = eig.eigenvalues();
   const double floor = 1e-12 * std::max(lambda.maxCoeff(), 1e-300);
@@ -35,19 +32,8 @@ std::optional<Matrix6d> motionCovariance(const SolverResult& s, const SolverPara
       degenerate = true;
     }
   }
-  // Neighbouring pairs of one point are far from independent measurements: the paper's
-  // curvature sums nnz pairs, but the information comes from the moving points. Scaling by
-  // pairs per point keeps one calibration valid whether colour lets few or many pairs through
-  // (measured: without it the flat-colour room's errors were 5x the textured room's relative
-  // to -H^-1). coarse_to_fine's information already weighs each point by its own kernel,
-  // whatever the number of its pairs (measured: with the factor the flat-colour room's errors
-  // were 2.8x smaller than the textured room's relative to the covariance, without it 1.x).
-  const double pairs_per_point = solver.ell_policy == EllPolicy::kCoarseToFine
-                                     ? 1.0
-                                     : double(std::max<std::size_t>(s.nnz, 1)) /
-                                           double(std::max<std::size_t>(moving_points, 1));
   const Matrix6d cov = eig.eigenvectors() * lambda.cwiseInverse().asDiagonal() *
-                       eig.eigenvectors().transpose() * (covariance_scale * pairs_per_point);
+                       eig.eigenvectors().transpose() * covariance_scale;
   if (degenerate || !cov.allFinite()) return std::nullopt;
   return cov;
 }

@@ -1,0 +1,101 @@
+// What every registration engine is to the odometry: it prepares a frame's cloud once (search
+// structures; more when the cloud becomes a reference that later frames are registered to),
+// registers a moving cloud to a fixed one from a guess, and says how well the result is known.
+// Two engines implement it: coarse_to_fine (the default, registration/coarse_to_fine.hpp) and
+// paper (A-CVO and CVO, registration/paper.hpp); makeRegistrationEngine picks one by name.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "acvo/labelled_cloud.hpp"
+#include "acvo/params.hpp"
+#include "acvo/se3.hpp"
+
+namespace acvo {
+
+enum class SolverStatus { kConverged, kMaxIterations, kTooFewPoints, kNotFinite };
+std::string toString(SolverStatus s);
+
+// What one iteration did (kept for tests, benchmarks and diagnosis; a few doubles each).
+struct IterationTrace {
+  double ell = 0.0;        // length-scale used by the iteration
+  double ell_max = 0.0;    // ell_max after the iteration's update (paper engine)
+  double step = 0.0;       // step size t (1 for a Gauss-Newton step)
+  double change = 0.0;     // the SE(3) change of the iteration
+  double objective = 0.0;  // F before the update
+  std::int64_t nnz = 0;
+};
+
+// The outcome of one registration.
+struct SolverResult {
+  // Maps points of the moving (current) cloud into the fixed (reference) cloud's frame.
+  Eigen::Isometry3d transform = Eigen::Isometry3d::Identity();
+  SolverStatus status = SolverStatus::kTooFewPoints;
+  int iterations = 0;
+  double ell = 0.0;     // final spatial length-scale
+  std::size_t nnz = 0;  // kept kernel pairs at the returned transform
+  // Fraction of the moving points with at least one kept pair at the returned transform: how
+  // much of this frame found something to hold on to in the reference.
+  double matched_fraction = 0.0;
+  double objective = 0.0;  // F at the optimum
+  // Curvature of F at the optimum w.r.t. a left perturbation (omega, v) of the transform, 6x6,
+  // negative semi-definite at a maximum: its negative is the information of the registration.
+  Matrix6d hessian = Matrix6d::Zero();
+  // Why the engine found this registration hard to trust (empty when it did not): the
+  // odometry judges such a frame hard to track.
+  std::string hard;
+  // The paper engine's own diagnostics (zero for coarse_to_fine).
+  int coarse_iterations = 0;     // coarse-stage iterations
+  bool stalled = false;          // stopped by the stall rule (the best iterate is returned)
+  bool ell_at_bound = false;     // final ell pinned at ell_min or at the (shrunk) ell_max
+  int ell_bound_iterations = 0;  // iterations that ended with ell pinned at a bound
+  int ell_max_reductions = 0;    // times ell reached ell_max and the bound shrank
+  double inner_product = 0.0;    // <f_X, h.f_Z> / (|f_X| |f_Z|), in [0, 1]
+  int list_builds = 0;           // candidate-list rebuilds
+  std::vector<IterationTrace> trace;
+  // Time per stage, milliseconds.
+  double ms_total = 0.0;
+  double ms_neighbours = 0.0;  // pair search, kernel and the sums of each iteration
+  double ms_step = 0.0;        // step-size pass (paper)
+  double ms_ell = 0.0;         // length-scale update (paper)
+};
+
+// A frame's cloud with what an engine built for it once. Each engine makes its own kind
+// (a derived type) and only ever receives the kind it made.
+struct PreparedCloud {
+  virtual ~PreparedCloud() = default;
+  LabelledCloud cloud;
+  bool reference = false;  // what a cloud registered *to* needs is built too
+  double ms_prepare = 0.0;
+
+  std::size_t size() const { return cloud.size(); }
+};
+
+class RegistrationEngine {
+ public:
+  virtual ~RegistrationEngine() = default;
+  // A frame's cloud with its per-frame structures; `as_reference`: also what a reference needs.
+  virtual std::shared_ptr<PreparedCloud> prepare(LabelledCloud cloud, bool as_reference) const = 0;
+  // Builds what a cloud registered *to* needs, once (a keyframe when it becomes one); returns
+  // the milliseconds it took (0 when already done).
+  virtual double prepareReference(PreparedCloud& cloud) const = 0;
+  // Registers `moving` onto `fixed` (a reference) starting from `guess`.
+  virtual SolverResult align(const PreparedCloud& fixed, const PreparedCloud& moving,
+                             const Eigen::Isometry3d& guess) const = 0;
+  // Covariance of a registered motion (T: moving -> fixed, in the fixed frame's axes); nullopt
+  // when the result does not constrain every direction.
+  virtual std::optional<Matrix6d> covariance(const SolverResult& s,
+                                             std::size_t moving_points) const = 0;
+  virtual int minPoints() const = 0;
+};
+
+// The engine Params::registration.engine names, with its parameters.
+std::unique_ptr<RegistrationEngine> makeRegistrationEngine(const Params& params);
+
+}  // namespace acvo

@@ -1,0 +1,104 @@
+// The default engine (docs/method.md §6): the paper's kernel sum F, shaped for real depth
+// (a Gaussian kept to 3 ell, each point's length-scale in proportion to its depth and stretched
+// along its viewing ray by the depth noise) and maximised level by level, from a wide
+// length-scale on a few points to the finest on all of them, by Gauss-Newton steps on the
+// quadratic that minorises F at the current kernel values.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "acvo/params.hpp"
+#include "acvo/registration.hpp"
+#include "acvo/registration/kernel.hpp"
+
+namespace acvo {
+
+// A cloud as this engine prepares it: a reference gets one search grid per level.
+struct CoarseToFineCloud : PreparedCloud {
+  std::vector<VoxelGrid> level_grids;  // one per levelElls, built by prepareReference
+};
+
+// The length-scales of the levels: ell_init, ell_init * ell_reduction, ... down to ell_min
+// (always the last).
+std::vector<double> levelElls(const CoarseToFineParams& p);
+
+// Range-dependent length-scale (ell_depth_reference): a point at depth z uses ell * ellScale(z),
+// z / reference clamped to [kMinEllScale, kMaxEllScale]; 1 when off.
+constexpr float kMinEllScale = 0.5f, kMaxEllScale = 3.0f;
+float ellScale(float z, const CoarseToFineParams& p);
+// Whether the kernel is shaped per point (ell_depth_reference or depth_noise set), and the
+// largest factor by which a point's search radius may then exceed the unit radius.
+bool perPointKernel(const CoarseToFineParams& p);
+float maxEllScale(const CoarseToFineParams& p);
+
+// What one kernel pass sums over the kept pairs at a transform.
+struct LevelSums {
+  double F = 0.0;             // sum a_ij
+  std::int64_t nnz = 0;       // kept pairs
+  std::int64_t matched = 0;   // moving points with at least one kept pair
+  // With the kernel values a_ij held fixed, exp(-u) >= exp(-u0)(1 - (u - u0)) makes
+  // sum a_ij u_ij(T) a quadratic whose decrease raises F (a minorise-maximise step, EM-ICP's).
+  // H xi = g are its Gauss-Newton normal equations for a left perturbation xi = (omega, v).
+  Matrix6d H = Matrix6d::Zero();
+  Vector6d g = Vector6d::Zero();
+};
+
+// The kernel pass of one level: the pairs of fixed and moving points at a transform, each
+// weighed by its own point's kernel.
+class LevelKernel {
+ public:
+  LevelKernel(const LabelledCloud& fixed, const LabelledCloud& moving, const VoxelGrid& grid,
+              const CoarseToFineParams& params);
+  const LevelSums& evaluate(const Eigen::Isometry3d& T, double ell);
+  int listBuilds() const { return lists_.builds(); }
+
+ private:
+  void shapeFor(double ell);  // the per-point kernel shapes at `ell`
+
+  const LabelledCloud& fixed_;
+  const LabelledCloud& moving_;
+  CoarseToFineParams params_;
+  KernelConstants k_;
+  CandidateLists lists_;
+  std::vector<float> scale_;  // per moving point: its length-scale / ell (ellScale)
+  std::vector<float> kappa_;  // per moving point: depth-noise share along its ray
+  double shaped_ell_ = -1.0;  // the ell the shapes were computed for
+  std::vector<LevelSums> partial_;
+  LevelSums sums_;
+};
+
+// A Gauss-Newton step (a left increment, se(3)) extended along its direction: the steps of
+// the minorise-maximise iteration shrink geometrically (ratio 0.4-0.7 per iteration on real
+// frames), so when `step` points the way `previous` did (cosine above 0.9) and is shorter by a
+// ratio rho < 1, the rest of that geometric series is taken at once:
+// step / (1 - min(rho, max_ratio)). `step` itself otherwise, and when max_ratio is 0.
+Vector6d extrapolatedStep(const Vector6d& step, const Vector6d& previous, double max_ratio);
+
+// The engine's steps as functions of values (the engine class below only holds the parameters).
+std::shared_ptr<CoarseToFineCloud> prepareCoarseToFine(LabelledCloud cloud,
+                                                      const CoarseToFineParams& p,
+                                                      bool as_reference);
+double prepareCoarseToFineReference(CoarseToFineCloud& cloud, const CoarseToFineParams& p);
+SolverResult alignCoarseToFine(const CoarseToFineCloud& fixed, const CoarseToFineCloud& moving,
+                               const Eigen::Isometry3d& guess, const CoarseToFineParams& p);
+
+class CoarseToFineEngine : public RegistrationEngine {
+ public:
+  explicit CoarseToFineEngine(const CoarseToFineParams& params) : params_(params) {}
+  std::shared_ptr<PreparedCloud> prepare(LabelledCloud cloud, bool as_reference) const override;
+  double prepareReference(PreparedCloud& cloud) const override;
+  SolverResult align(const PreparedCloud& fixed, const PreparedCloud& moving,
+                     const Eigen::Isometry3d& guess) const override;
+  // covariance_scale (-H)^-1: the information weighs each point by its own kernel, whatever
+  // the number of its pairs.
+  std::optional<Matrix6d> covariance(const SolverResult& s,
+                                     std::size_t moving_points) const override;
+  int minPoints() const override { return params_.min_points; }
+
+ private:
+  CoarseToFineParams params_;
+};
+
+}  // namespace acvo

@@ -1,0 +1,108 @@
+// The paper's engine (docs/method.md §3-§4): A-CVO (the length-scale learned online) and CVO
+// (its fixed schedule). Each iteration moves the transform along the kernel's ascent direction
+// by the step of a 4th-order model of F, then updates the length-scale. The pieces of one
+// iteration are functions here, tested one by one; alignPaper strings them together.
+#pragma once
+
+#include <cmath>
+#include <memory>
+#include <optional>
+
+#include <Eigen/Geometry>
+
+#include "acvo/params.hpp"
+#include "acvo/registration.hpp"
+#include "acvo/registration/paper_kernel.hpp"
+
+namespace acvo {
+
+// Step size: the smallest positive real root of 4E t^3 + 3D t^2 + 2C t + B = 0; min_step when
+// there is none; capped at max_step. Double precision, degenerate leading terms handled.
+double solveStep(double B, double C, double D, double E, double min_step, double max_step);
+
+// Search direction of a conjugate-gradient iteration (Polak-Ribiere+) from the gradient g, the
+// previous gradient and the previous direction; always an ascent direction (d.g > 0), g itself
+// when the previous iteration gives nothing to build on.
+Vector6d conjugateDirection(const Vector6d& g, const Vector6d& g_prev, const Vector6d& d_prev);
+
+// The direction of each iteration from its gradient: the gradient itself, or conjugate
+// gradient (conjugateDirection) from the second iteration on.
+class SearchState {
+ public:
+  Vector6d next(const Vector6d& gradient, SearchDirection kind);
+
+ private:
+  bool started_ = false;
+  Vector6d g_prev_ = Vector6d::Zero(), d_prev_ = Vector6d::Zero();
+};
+
+// The adaptive length-scale of one registration: ell and its upper bound, reset per frame;
+// `reductions` counts the times ell reached the bound and it shrank.
+struct LengthScale {
+  double ell = 0.0, ell_max = 0.0;
+  int reductions = 0;
+  bool pinned(const PaperParams& p) const;  // at ell_min or at the (shrunk) ell_max
+};
+
+// dJ/dell of J = |f_X - h.f_Z|^2 from the self-kernel sums of both clouds and the cross sums
+// of one iteration at `ell`, divided by nnz(Axx) + nnz(Ayy) - 2 nnz(A) over all rows.
+// `update` descent divides only by a positive count; reference (the authors' code) by any
+// non-zero one.
+double lengthScaleGradient(const SelfSums& xx, const SelfSums& yy, const CrossSums& xy, double ell,
+                           EllUpdate update = EllUpdate::kDescent);
+
+// One step of ell along -gradient (descent; `reference`: +gradient, the authors' code); on
+// reaching ell_max the bound shrinks by ell_reduction (never below ell_min) and ell takes it;
+// ell never below ell_min. A gradient that is not finite changes nothing. Returns whether ell
+// ends pinned at a bound.
+bool updateLengthScale(LengthScale& ls, double gradient, const PaperParams& p);
+
+// The stall rule (PaperParams::stall_iterations): remembers the best objective seen at the
+// current length-scale; stalls() says when `patience` iterations in a row at that length-scale
+// brought nothing better (best() is then the transform to keep). Never stalls for patience 0.
+class StallTracker {
+ public:
+  explicit StallTracker(int patience) : patience_(patience) {}
+  bool stalls(double ell, double F, const Eigen::Isometry3d& T);
+  const Eigen::Isometry3d& best() const { return best_T_; }
+
+ private:
+  int patience_;
+  double ell_ = -1.0, best_F_ = -INFINITY;
+  Eigen::Isometry3d best_T_ = Eigen::Isometry3d::Identity();
+  int since_best_ = 0;
+};
+
+// The length-scale of a fixed-schedule iteration, as the authors' CVO code switches it: 0.15
+// for iterations 0-3, 0.10 for 4-10, 0.06 for 11-20, 0.03 from 21 on.
+double scheduledEll(int iteration);
+
+std::shared_ptr<PaperCloud> preparePaper(LabelledCloud cloud, const PaperParams& p,
+                                         bool as_reference);
+double preparePaperReference(PaperCloud& cloud, const PaperParams& p);
+// `carried_ell` > 0: the fixed schedule's first stage runs at it (PaperParams::carry_ell).
+SolverResult alignPaper(const PaperCloud& fixed, const PaperCloud& moving,
+                        const Eigen::Isometry3d& guess, const PaperParams& p,
+                        double carried_ell = 0.0);
+
+class PaperEngine : public RegistrationEngine {
+ public:
+  explicit PaperEngine(const PaperParams& params) : params_(params) {}
+  std::shared_ptr<PreparedCloud> prepare(LabelledCloud cloud, bool as_reference) const override;
+  double prepareReference(PreparedCloud& cloud) const override;
+  SolverResult align(const PreparedCloud& fixed, const PreparedCloud& moving,
+                     const Eigen::Isometry3d& guess) const override;
+  // covariance_scale * (pairs per point) * (-H)^-1: neighbouring pairs of one point are far
+  // from independent measurements, the information comes from the moving points.
+  std::optional<Matrix6d> covariance(const SolverResult& s,
+                                     std::size_t moving_points) const override;
+  int minPoints() const override { return params_.min_points; }
+
+ private:
+  PaperParams params_;
+  // The final length-scale of the last registration (carry_ell); the odometry registers one
+  // frame at a time, so this state is never shared between threads.
+  mutable double carried_ell_ = 0.0;
+};
+
+}  // namespace acvo

@@ -1,0 +1,181 @@
+// The default engine's levels (docs/method.md §6): its clouds, the level-by-level Gauss-Newton
+// iteration, and its covariance.
+#include "acvo/registration/coarse_to_fine.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <stdexcept>
+
+#include <Eigen/Cholesky>
+
+#include "acvo/covariance.hpp"
+
+namespace acvo {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+// Steps this well aligned (cosine) are taken as one linear convergence (extrapolatedStep).
+constexpr double kAlignedSteps = 0.9;
+
+// One Gauss-Newton step on the minorising quadratic of the last evaluate(): the left increment
+// that raises F. Identity when the pairs constrain nothing.
+Eigen::Isometry3d levelStep(const LevelSums& s) {
+  const Eigen::LDLT<Matrix6d> ldlt(s.H);
+  if (ldlt.info() != Eigen::Success || !(s.H.trace() > 0.0)) return Eigen::Isometry3d::Identity();
+  const Vector6d xi = ldlt.solve(s.g);
+  return xi.allFinite() ? expSE3(xi) : Eigen::Isometry3d::Identity();
+}
+
+// Iterates one level from T; returns false when a step was not finite.
+bool iterateLevel(LevelKernel& kernel, double ell, double eps, bool last,
+                  const CoarseToFineParams& p, Eigen::Isometry3d& T, SolverResult& result) {
+  Vector6d previous = Vector6d::Zero();
+  for (int it = 0; it < p.level_iterations; ++it) {
+    const auto t0 = Clock::now();
+    const LevelSums& s = kernel.evaluate(T, ell);
+    result.ms_neighbours += msSince(t0);
+    const Eigen::Isometry3d step = levelStep(s);
+    if (!step.matrix().allFinite()) return false;
+    const Vector6d xi = extrapolatedStep(logSE3(step), previous, p.level_acceleration);
+    T = normalized(expSE3(xi) * T);
+    previous = xi;
+    result.trace.push_back({ell, ell, 1.0, xi.norm(), s.F, s.nnz});
+    ++result.iterations;
+    if (xi.head<3>().norm() < eps && xi.tail<3>().norm() < eps) break;
+    if (last && it + 1 == p.level_iterations) result.status = SolverStatus::kMaxIterations;
+  }
+  return true;
+}
+
+}  // namespace
+
+std::vector<double> levelElls(const CoarseToFineParams& p) {
+  std::vector<double> ells;
+  for (double ell = p.ell_init; ell > p.ell_min * (1.0 + 1e-9); ell *= p.ell_reduction) {
+    ells.push_back(ell);
+  }
+  ells.push_back(p.ell_min);
+  return ells;
+}
+
+Vector6d extrapolatedStep(const Vector6d& step, const Vector6d& previous, double max_ratio) {
+  const double n = step.norm(), n_prev = previous.norm();
+  if (!(max_ratio > 0.0) || !(n > 0.0) || !(n_prev > 0.0)) return step;
+  const double ratio = n / n_prev;
+  if (!(ratio < 1.0) || step.dot(previous) < kAlignedSteps * n * n_prev) return step;
+  return step / (1.0 - std::min(ratio, max_ratio));
+}
+
+std::shared_ptr<CoarseToFineCloud> prepareCoarseToFine(LabelledCloud cloud,
+                                                      const CoarseToFineParams& p,
+                                                      bool as_reference) {
+  auto out = std::make_shared<CoarseToFineCloud>();
+  out->cloud = std::move(cloud);
+  if (as_reference) prepareCoarseToFineReference(*out, p);
+  return out;
+}
+
+double prepareCoarseToFineReference(CoarseToFineCloud& cloud, const CoarseToFineParams& p) {
+  if (cloud.reference) return 0.0;
+  const auto t0 = Clock::now();
+  for (double ell : levelElls(p)) {
+    cloud.level_grids.emplace_back(
+        cloud.cloud.points, gridCell(ell, p.sigma, p.sparsification, maxEllScale(p)));
+  }
+  cloud.reference = true;
+  const double ms = msSince(t0);
+  cloud.ms_prepare += ms;
+  return ms;
+}
+
+SolverResult alignCoarseToFine(const CoarseToFineCloud& fixed, const CoarseToFineCloud& moving,
+                               const Eigen::Isometry3d& guess, const CoarseToFineParams& p) {
+  const auto t_start = Clock::now();
+  SolverResult result;
+  result.transform = guess;
+  const std::vector<double> ells = levelElls(p);
+  result.ell = ells.back();
+  if (int(fixed.size()) < p.min_points || int(moving.size()) < p.min_points) {
+    result.status = SolverStatus::kTooFewPoints;
+    result.ms_total = msSince(t_start);
+    return result;
+  }
+  if (!fixed.reference) throw std::logic_error("align: the fixed cloud is not a reference");
+  if (!guess.matrix().allFinite()) {
+    result.status = SolverStatus::kNotFinite;
+    result.transform = Eigen::Isometry3d::Identity();
+    result.ms_total = msSince(t_start);
+    return result;
+  }
+
+  // Pairs per point grow with the kernel's reach: fewer moving points at the wide levels
+  // (level_points at the first, in proportion to 1 / ell after it, all at the last).
+  Eigen::Isometry3d T = guess;
+  result.status = SolverStatus::kConverged;
+  std::unique_ptr<LevelKernel> kernel;
+  LabelledCloud subset;
+  const int levels = int(ells.size());
+  for (int level = 0; level < levels; ++level) {
+    const double ell = ells[std::size_t(level)];
+    const bool last = level + 1 == levels;
+    const int count = int(std::min<double>(moving.size(), p.level_points * ells.front() / ell));
+    kernel.reset();
+    const bool strided = !last && count < int(moving.size());
+    if (strided) subset = stridedSubset(moving.cloud, count);
+    kernel = std::make_unique<LevelKernel>(fixed.cloud, strided ? subset : moving.cloud,
+                                           fixed.level_grids[std::size_t(level)], p);
+    // A level need not resolve the motion finer than its length-scale allows: the next level
+    // refines it (measured: a third fewer iterations, the same accuracy).
+    const double eps = p.level_eps * ell / ells.back();
+    if (!iterateLevel(*kernel, ell, eps, last, p, T, result)) {
+      result.status = SolverStatus::kNotFinite;
+      result.transform = guess;
+      result.ms_total = msSince(t_start);
+      return result;
+    }
+  }
+  result.transform = T;
+  if (!T.matrix().allFinite()) {
+    result.status = SolverStatus::kNotFinite;
+    result.transform = guess;
+  }
+  // Final figures on the full cloud at the finest length-scale: the last level's kernel.
+  const LevelSums& s = kernel->evaluate(T, ells.back());
+  result.nnz = std::size_t(s.nnz);
+  result.matched_fraction = double(s.matched) / double(std::max<std::size_t>(moving.size(), 1));
+  result.objective = s.F;
+  // The information of the minorising quadratic at the optimum (the Gauss-Newton matrix the
+  // steps solve with); the exact curvature of the narrow kernel is no better conditioned.
+  result.hessian = -s.H;
+  result.list_builds = kernel->listBuilds();
+  result.ms_total = msSince(t_start);
+  return result;
+}
+
+std::shared_ptr<PreparedCloud> CoarseToFineEngine::prepare(LabelledCloud cloud,
+                                                           bool as_reference) const {
+  return prepareCoarseToFine(std::move(cloud), params_, as_reference);
+}
+
+double CoarseToFineEngine::prepareReference(PreparedCloud& cloud) const {
+  return prepareCoarseToFineReference(static_cast<CoarseToFineCloud&>(cloud), params_);
+}
+
+SolverResult CoarseToFineEngine::align(const PreparedCloud& fixed, const PreparedCloud& moving,
+                                       const Eigen::Isometry3d& guess) const {
+  return alignCoarseToFine(static_cast<const CoarseToFineCloud&>(fixed),
+                           static_cast<const CoarseToFineCloud&>(moving), guess, params_);
+}
+
+std::optional<Matrix6d> CoarseToFineEngine::covariance(const SolverResult& s,
+                                                       std::size_t /*moving_points*/) const {
+  return scaledInverseInformation(-s.hessian, params_.covariance_scale);
+}
+
+}  // namespace acvo

@@ -1,0 +1,206 @@
+// The kernel pieces both engines share: sparsification, the voxel grid, the candidate lists.
+#include "acvo/registration/kernel.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+namespace acvo {
+
+double sparsificationThreshold(int order, double tolerance) {
+  // With u = 1/(2 s^2), g = exp(-u) and the expansion truncated at order n in 1/s keeps the
+  // terms (-u)^k / k! for k <= n/2. The truncation error grows with u from 0, so the answer is
+  // exp(-u*) for the first u* where it reaches the tolerance.
+  const int kmax = order / 2;
+  auto error = [kmax](double u) {
+    double term = 1.0, sum = 1.0;
+    for (int k = 1; k <= kmax; ++k) {
+      term *= -u / k;
+      sum += term;
+    }
+    return std::abs(std::exp(-u) - sum);
+  };
+  double lo = 0.0, hi = 0.0;
+  const double du = 1e-3;
+  while (error(hi) <= tolerance) {
+    lo = hi;
+    hi += du;
+    if (hi > 50.0) return std::exp(-hi);  // tolerance never reached: threshold vanishes
+  }
+  for (int it = 0; it < 100; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (error(mid) <= tolerance ? lo : hi) = mid;
+  }
+  return std::exp(-lo);
+}
+
+double spatialRadius2(double ell, double sigma, double threshold) {
+  const double s2 = sigma * sigma;
+  if (threshold <= 0.0) return std::numeric_limits<double>::infinity();
+  if (threshold >= s2) return 0.0;
+  return -2.0 * ell * ell * std::log(threshold / s2);
+}
+
+VoxelGrid::VoxelGrid(const std::vector<Eigen::Vector3f>& points, float cell) : cell_(cell) {
+  if (points.empty() || !(cell > 0.0f)) return;
+  // A non-finite point (from absurd intrinsics) has no place in the grid and no neighbours: it is
+  // left out, and the box spans the finite points only.
+  auto finite = [](const Eigen::Vector3f& p) { return p.allFinite(); };
+  const auto first = std::find_if(points.begin(), points.end(), finite);
+  if (first == points.end()) return;
+  Eigen::Vector3f lo = *first, hi = *first;
+  for (const auto& p : points) {
+    if (!finite(p)) continue;
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  // A cloud spread far beyond the radius would make a huge dense grid: coarsen the cells then
+  // (candidates stay a superset of the true neighbours, searches only get slower). The extent is
+  // taken in double: hi - lo of finite floats may overflow float.
+  constexpr double kMaxCells = 4e6;
+  const Eigen::Vector3d extent = hi.cast<double>() - lo.cast<double>();
+  for (;;) {
+    const Eigen::Vector3d n = (extent / double(cell_)).array().floor() + 1.0;
+    if (n.x() * n.y() * n.z() <= kMaxCells) {
+      nx_ = int(n.x()), ny_ = int(n.y()), nz_ = int(n.z());
+      break;
+    }
+    cell_ *= 1.5f;
+  }
+  origin_ = lo;
+  const int cells = nx_ * ny_ * nz_;
+  const Eigen::Vector3f top(float(nx_ - 1), float(ny_ - 1), float(nz_ - 1));
+  std::vector<int> cell_of(points.size(), -1);
+  cell_start_.assign(cells + 1, 0);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (!finite(points[i])) continue;
+    // Clamped before the conversion to int: p - origin may overflow float to +inf.
+    const Eigen::Vector3f r = ((points[i] - origin_) / cell_).cwiseMin(top);
+    const int x = int(r.x()), y = int(r.y()), z = int(r.z());
+    cell_of[i] = (z * ny_ + y) * nx_ + x;
+    ++cell_start_[cell_of[i] + 1];
+  }
+  for (int c = 0; c < cells; ++c) cell_start_[c + 1] += cell_start_[c];
+  order_.resize(cell_start_.back());
+  std::vector<int> fill(cell_start_.begin(), cell_start_.end() - 1);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (cell_of[i] >= 0) order_[fill[cell_of[i]]++] = int(i);
+  }
+}
+
+float gridCell(double ell, double sigma, double sparsification, float max_scale) {
+  const double r2 = spatialRadius2(ell, sigma, sparsification);
+  // Cells a little larger than the search radius: the candidate lists carry a margin beyond the
+  // radius and a grid only guarantees neighbours within one cell.
+  return (std::isfinite(r2) && r2 > 0.0 ? 1.3f * float(std::sqrt(r2)) + 0.002f : 0.1f) *
+         max_scale;
+}
+
+KernelConstants kernelConstants(double sigma, double color_ell, double color_sigma,
+                                double sparsification) {
+  KernelConstants k;
+  k.sigma2 = float(sigma * sigma);
+  k.color_sigma2 = float(color_sigma * color_sigma);
+  k.color_inv = float(1.0 / (2.0 * color_ell * color_ell));
+  k.sparsification = float(sparsification);
+  return k;
+}
+
+CandidateLists::CandidateLists(const LabelledCloud& fixed, const LabelledCloud& moving,
+                               const VoxelGrid& grid, const KernelConstants& k)
+    : fixed_(fixed),
+      moving_(moving),
+      grid_(grid),
+      k_(k),
+      search_scale_(moving.size(), 1.0f),
+      chunks_((moving.size() + kChunk - 1) / kChunk) {}
+
+void CandidateLists::setSearchScales(std::vector<float> scales, float min_scale,
+                                     float max_scale) {
+  search_scale_ = std::move(scales);
+  min_scale_ = min_scale;
+  max_scale_ = max_scale;
+  valid_ = false;
+  radius_ = 0.0f;
+}
+
+void CandidateLists::update(const Eigen::Isometry3d& T, float r) {
+  // How far the moving points have moved since the lists were built (exactly: a bound through
+  // ||dR|| |z|max is loose enough to force a rebuild after a tenth of a degree).
+  float moved = INFINITY;
+  if (valid_) {
+    const Eigen::Matrix3f dR = (T.linear() - T_.linear()).cast<float>();
+    const Eigen::Vector3f dt = (T.translation() - T_.translation()).cast<float>();
+    float worst2 = 0.0f;
+    for (const auto& z : moving_.points) worst2 = std::max(worst2, (dR * z + dt).squaredNorm());
+    // In units of each point's own search radius the smallest scale moved the most.
+    moved = std::sqrt(worst2) / min_scale_;
+  }
+  const float cell = grid_.cell() / max_scale_;
+  if (r + moved > radius_ || radius_ > 1.6f * r + 0.005f) {
+    build(T, std::min(1.3f * r + 0.002f, std::max(cell, r)));
+  }
+}
+
+void CandidateLists::build(const Eigen::Isometry3d& T, float radius) {
+  const Eigen::Matrix3f R = T.linear().cast<float>();
+  const Eigen::Vector3f t = T.translation().cast<float>();
+  const auto& X = fixed_.points;
+  const auto& fx = fixed_.labels;
+  const auto& Z = moving_.points;
+  const auto& gz = moving_.labels;
+  const int n = int(Z.size());
+  forEachChunk(int(chunks_.size()), [&](int c) {
+    Chunk& chunk = chunks_[std::size_t(c)];
+    chunk.end.clear();
+    chunk.i.clear();
+    chunk.color.clear();
+    chunk.x.clear();
+    chunk.y.clear();
+    chunk.z.clear();
+    int longest = 0, start = 0;
+    const int end = std::min(n, (c + 1) * kChunk);
+    for (int j = c * kChunk; j < end; ++j) {
+      const Eigen::Vector3f y = R * Z[std::size_t(j)] + t;
+      const float rj = radius * search_scale_[std::size_t(j)];
+      const float radius2 = rj * rj;
+      grid_.forEachCandidate(y, [&](int i) {
+        if (!((X[std::size_t(i)] - y).squaredNorm() < radius2)) return;
+        const float cf = colorFactor(fx[std::size_t(i)], gz[std::size_t(j)], k_.color_inv,
+                                     k_.color_sigma2);
+        if (k_.sigma2 * cf < k_.sparsification) return;  // fails at any distance
+        chunk.i.push_back(i);
+        chunk.color.push_back(cf);
+        chunk.x.push_back(X[std::size_t(i)].x());
+        chunk.y.push_back(X[std::size_t(i)].y());
+        chunk.z.push_back(X[std::size_t(i)].z());
+      });
+      chunk.end.push_back(int(chunk.i.size()));
+      longest = std::max(longest, chunk.end.back() - start);
+      start = chunk.end.back();
+    }
+    if (chunk.scratch_d2.size() < longest) {
+      chunk.scratch_d2.resize(longest);
+      chunk.scratch_a.resize(longest);
+    }
+  });
+  T_ = T;
+  radius_ = radius;
+  valid_ = true;
+  ++builds_;
+}
+
+LabelledCloud stridedSubset(const LabelledCloud& cloud, int count) {
+  LabelledCloud subset;
+  const int n = int(cloud.size());
+  const int stride = std::max(1, n / std::max(count, 1));
+  for (int j = 0; j < n; j += stride) {
+    subset.points.push_back(cloud.points[std::size_t(j)]);
+    subset.labels.push_back(cloud.labels[std::size_t(j)]);
+  }
+  return subset;
+}
+
+}  // namespace acvo

@@ -1,0 +1,140 @@
+// The default engine's kernel pass (docs/method.md §6): per moving point, its candidate pairs'
+// kernel values under the point's own length-scale (in proportion to its depth, stretched along
+// its viewing ray by the depth noise), and the Gauss-Newton normal equations of the quadratic
+// that minorises F there.
+#include <algorithm>
+#include <cmath>
+
+#include "acvo/registration/coarse_to_fine.hpp"
+
+namespace acvo {
+
+float ellScale(float z, const CoarseToFineParams& p) {
+  if (!(p.ell_depth_reference > 0.0)) return 1.0f;
+  const float s = z / float(p.ell_depth_reference);
+  return s < kMinEllScale ? kMinEllScale : (s > kMaxEllScale ? kMaxEllScale : s);
+}
+
+bool perPointKernel(const CoarseToFineParams& p) {
+  return p.ell_depth_reference > 0.0 || p.depth_noise > 0.0;
+}
+
+float maxEllScale(const CoarseToFineParams& p) {
+  return perPointKernel(p) ? kMaxEllScale : 1.0f;
+}
+
+LevelKernel::LevelKernel(const LabelledCloud& fixed, const LabelledCloud& moving,
+                         const VoxelGrid& grid, const CoarseToFineParams& params)
+    : fixed_(fixed),
+      moving_(moving),
+      params_(params),
+      k_(kernelConstants(params.sigma, params.color_ell, params.color_sigma,
+                         params.sparsification)),
+      lists_(fixed, moving, grid, k_),
+      scale_(moving.size(), 1.0f),
+      kappa_(moving.size(), 0.0f),
+      partial_(std::size_t(lists_.chunks())) {}
+
+void LevelKernel::shapeFor(double ell) {
+  shaped_ell_ = ell;
+  std::vector<float> search(moving_.size(), 1.0f);
+  float min_scale = kMaxEllScale;
+  for (std::size_t j = 0; j < moving_.size(); ++j) {
+    const float z = moving_.points[j].z();
+    scale_[j] = ellScale(z, params_);
+    // Both points' depth noise along the ray against the kernel's own width there: the part of
+    // the distance along the ray counts (1 - kappa) times.
+    const float noise = float(params_.depth_noise) * z * z;
+    const float l = float(ell) * scale_[j];
+    kappa_[j] = 2.0f * noise * noise / (l * l + 2.0f * noise * noise);
+    search[j] = std::min(scale_[j] / std::sqrt(1.0f - kappa_[j]), kMaxEllScale);
+    min_scale = std::min(min_scale, search[j]);
+  }
+  // New shapes, new lists.
+  lists_.setSearchScales(std::move(search), min_scale, maxEllScale(params_));
+}
+
+const LevelSums& LevelKernel::evaluate(const Eigen::Isometry3d& T, double ell) {
+  if (perPointKernel(params_) && ell != shaped_ell_) shapeFor(ell);
+  const double r2_exact = spatialRadius2(ell, params_.sigma, params_.sparsification);
+  const float r = float(std::sqrt(std::min(r2_exact, 1e6)));
+  lists_.update(T, r);
+
+  const Eigen::Matrix3f R = T.linear().cast<float>();
+  const Eigen::Vector3f t = T.translation().cast<float>();
+  const float r2_unit = r * r;
+  const float inv_unit = float(1.0 / (2.0 * ell * ell));
+  const float sigma2 = k_.sigma2, sp = k_.sparsification;
+  const auto& X = fixed_.points;
+  const auto& Z = moving_.points;
+  const int n = int(Z.size());
+
+  forEachChunk(lists_.chunks(), [&](int c) {
+    CandidateLists::Chunk& chunk = lists_.chunk(c);
+    // Per-chunk accumulation in double; one point's few terms are summed in float.
+    LevelSums s;
+    int k = 0;
+    const int end = std::min(n, (c + 1) * kChunk);
+    for (int j = c * kChunk; j < end; ++j) {
+      const Eigen::Vector3f y = R * Z[std::size_t(j)] + t;
+      const float scale = scale_[std::size_t(j)], search = lists_.searchScale(j);
+      const float s2 = scale * scale;
+      const float r2 = r2_unit * search * search, inv = inv_unit / s2;
+      const float kappa = kappa_[std::size_t(j)];
+      const Eigen::Vector3f ray = y.normalized();
+      Eigen::Vector3f x_sum = Eigen::Vector3f::Zero();
+      float a_sum = 0.0f;
+      const int k_end = chunk.end[std::size_t(j - c * kChunk)];
+      const int m = k_end - k;
+      if (m > 0) {
+        // Vectorised: squared distances and kernel values of all candidates of this point.
+        using Map = Eigen::Map<const Eigen::ArrayXf>;
+        auto d2 = chunk.scratch_d2.head(m);
+        auto a = chunk.scratch_a.head(m);
+        const Map cx(chunk.x.data() + k, m), cy(chunk.y.data() + k, m), cz(chunk.z.data() + k, m);
+        d2 = (cx - y.x()).square() + (cy - y.y()).square() + (cz - y.z()).square();
+        if (kappa > 0.0f) {
+          const auto along = (cx - y.x()) * ray.x() + (cy - y.y()) * ray.y() + (cz - y.z()) * ray.z();
+          a = sigma2 * ((d2 - kappa * along.square()) * -inv).exp() * Map(chunk.color.data() + k, m);
+        } else {
+          a = sigma2 * (d2 * -inv).exp() * Map(chunk.color.data() + k, m);
+        }
+        for (int q = 0; q < m; ++q) {
+          if (!(d2[q] < r2) || a[q] < sp) continue;
+          const float aq = a[q];
+          x_sum += aq * X[std::size_t(chunk.i[std::size_t(k + q)])];
+          a_sum += aq;
+          ++s.nnz;
+        }
+      }
+      k = k_end;
+      if (a_sum > 0.0f) {
+        ++s.matched;
+        // This point's pairs weigh (x_i - y)^T W (x_i - y) by a_ij / ell_j^2,
+        // W = I - kappa ray ray^T; they share y, so they enter through sum a and sum a x.
+        const double w = 1.0 / double(s2);
+        const Eigen::Vector3d yd = y.cast<double>(), rd = ray.cast<double>();
+        const Eigen::Matrix3d W = Eigen::Matrix3d::Identity() - double(kappa) * rd * rd.transpose();
+        Eigen::Matrix<double, 3, 6> J;
+        J << -hat(yd), Eigen::Matrix3d::Identity();
+        const Eigen::Matrix<double, 6, 3> JtW = J.transpose() * W;
+        s.H += (w * double(a_sum)) * JtW * J;
+        s.g += w * JtW * (x_sum.cast<double>() - double(a_sum) * yd);
+      }
+      s.F += a_sum;
+    }
+    partial_[std::size_t(c)] = s;
+  });
+
+  sums_ = LevelSums();
+  for (const auto& s : partial_) {
+    sums_.F += s.F;
+    sums_.nnz += s.nnz;
+    sums_.H += s.H;
+    sums_.g += s.g;
+    sums_.matched += s.matched;
+  }
+  return sums_;
+}
+
+}  // namespace acvo
