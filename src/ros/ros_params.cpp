@@ -67,7 +67,12 @@ std::vector<std::string> applyRosParams(const XmlRpc::XmlRpcValue& private_ns,
     std::string problem = set(section + "/" + name, values[name], field);
     if (!problem.empty()) problems.push_back(problem);
   });
-  for (const char* section : {"selection", "solver", "odometry"}) {
+  if (private_ns.hasMember("solver")) {
+    problems.push_back("~solver was split (ignored): ~registration/engine chooses the engine, "
+                       "~coarse_to_fine and ~paper hold each engine's parameters "
+                       "(config/acvo.yaml, config/paper.yaml)");
+  }
+  for (const char* section : {"selection", "registration", "coarse_to_fine", "paper", "odometry"}) {
     if (!private_ns.hasMember(section)) continue;
     const XmlRpcValue& values = private_ns[section];
     if (values.getType() != XmlRpcValue::TypeStruct) {

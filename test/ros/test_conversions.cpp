@@ -337,6 +337,7 @@ TEST(RosParams, ReadsEverySectionWithCoreNamesAndReportsProblems) {
   ns["coarse_to_fine"] = section("no_such_key", 1);
   ns["odometry"] = section("initial_guess", std::string("sideways"));
   ns["approx_sync"] = true;  // a nodelet setting, not an algorithm parameter
+  ns["solver"] = section("ell_min", 0.01);  // the section before the engines were split
   acvo::Params p;
   const std::vector<std::string> problems = applyRosParams(ns, p);
   EXPECT_EQ(p.selection.target_points, 1234);
@@ -345,12 +346,13 @@ TEST(RosParams, ReadsEverySectionWithCoreNamesAndReportsProblems) {
   EXPECT_EQ(p.paper.ell_policy, acvo::EllPolicy::kFixedSchedule);
   EXPECT_EQ(p.paper.max_iterations, acvo::Params().paper.max_iterations);
   EXPECT_EQ(p.odometry.initial_guess, acvo::Params().odometry.initial_guess);
-  ASSERT_EQ(problems.size(), 3u);
+  ASSERT_EQ(problems.size(), 4u);
   std::string all;
   for (const auto& s : problems) all += s + "\n";
   EXPECT_NE(all.find("~paper/max_iterations"), std::string::npos) << all;
   EXPECT_NE(all.find("~odometry/initial_guess"), std::string::npos) << all;
   EXPECT_NE(all.find("~coarse_to_fine/no_such_key"), std::string::npos) << all;
+  EXPECT_NE(all.find("~solver was split"), std::string::npos) << all;
 }
 
 TEST(RosParams, ReconfigureRoundTripsAndDescribesEveryParameter) {
