@@ -4,11 +4,13 @@
 #include <cstring>
 #include <stdexcept>
 
+#include <pcl_conversions/pcl_conversions.h>
 #include <sensor_msgs/image_encodings.h>
 #include <tf2_eigen/tf2_eigen.h>
 #include <opencv2/imgproc.hpp>
 
 #include "acvo/depth.hpp"
+#include "point_types.hpp"
 
 namespace acvo_ros {
 namespace enc = sensor_msgs::image_encodings;
@@ -250,37 +252,34 @@ geometry_msgs::TransformStamped toTransformMsg(const Eigen::Isometry3d& pose,
 
 sensor_msgs::PointCloud2 toPointCloud2(const acvo::LabelledCloud& cloud,
                                        const std_msgs::Header& header) {
-  sensor_msgs::PointCloud2 msg;
-  msg.header = header;
-  msg.height = 1;
-  msg.width = static_cast<std::uint32_t>(cloud.size());
-  const char* names[] = {"x", "y", "z", "rgb"};
-  for (int i = 0; i < 4; ++i) {
-    sensor_msgs::PointField f;
-    f.name = names[i];
-    f.offset = 4 * i;
-    f.datatype = sensor_msgs::PointField::FLOAT32;
-    f.count = 1;
-    msg.fields.push_back(f);
-  }
-  msg.is_bigendian = hostIsBigEndian();
-  msg.point_step = 16;
-  msg.row_step = msg.point_step * msg.width;
-  msg.is_dense = true;
-  msg.data.resize(std::size_t{msg.row_step});
+  pcl::PointCloud<LabelledPoint> pc;
+  pc.resize(cloud.size());  // width = size, height = 1
   const bool has_rgb = cloud.rgb.size() == cloud.size();
+  const bool has_labels = cloud.labels.size() == cloud.size();
   for (std::size_t i = 0; i < cloud.size(); ++i) {
-    float xyzc[4];
-    xyzc[0] = cloud.points[i].x();
-    xyzc[1] = cloud.points[i].y();
-    xyzc[2] = cloud.points[i].z();
-    const std::uint32_t packed = has_rgb ? (std::uint32_t{cloud.rgb[i][0]} << 16) |
-                                               (std::uint32_t{cloud.rgb[i][1]} << 8) |
-                                               std::uint32_t{cloud.rgb[i][2]}
-                                         : 0x808080u;
-    std::memcpy(&xyzc[3], &packed, 4);
-    std::memcpy(&msg.data[i * msg.point_step], xyzc, sizeof xyzc);
+    LabelledPoint& p = pc[i];
+    p.x = cloud.points[i].x();
+    p.y = cloud.points[i].y();
+    p.z = cloud.points[i].z();
+    if (has_rgb) {
+      p.r = cloud.rgb[i][0];
+      p.g = cloud.rgb[i][1];
+      p.b = cloud.rgb[i][2];
+    } else {
+      p.r = p.g = p.b = 128;
+    }
+    p.a = 255;
+    const acvo::Label l = has_labels ? cloud.labels[i] : acvo::Label::Zero();
+    p.hue = l[0];
+    p.saturation = l[1];
+    p.value = l[2];
+    p.gradient_x = l[3];
+    p.gradient_y = l[4];
   }
+  pc.is_dense = true;
+  sensor_msgs::PointCloud2 msg;
+  pcl::toROSMsg(pc, msg);
+  msg.header = header;  // the ROS stamp as it came, not through PCL's microseconds
   return msg;
 }
 

@@ -105,8 +105,8 @@ geometry_msgs::TransformStamped toTransformMsg(const Eigen::Isometry3d& pose,
                                                const std::string& parent, const std::string& child,
                                                const ros::Time& stamp);
 
-// xyz (float32) + rgb (float32 holding 0x00RRGGBB, as rviz and PCL expect), unorganised, in the
-// camera frame of `header`.
+// The cloud as pcl::PointCloud<LabelledPoint> (point_types.hpp: xyz, packed rgb and the five
+// labels), unorganised, in the camera frame of `header`, converted by pcl::toROSMsg.
 sensor_msgs::PointCloud2 toPointCloud2(const acvo::LabelledCloud& cloud,
                                        const std_msgs::Header& header);
 

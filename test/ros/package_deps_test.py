@@ -34,7 +34,8 @@ HEADERS = {"ros": "roscpp"}
 # Declared system dependencies (rosdep keys) and the header folder or module that uses them.
 SYSTEM = {"eigen": "Eigen", "libopencv-dev": "opencv2", "yaml-cpp": "yaml-cpp", "tbb": "tbb",
           "python3-opencv": "cv2", "python3-yaml": "yaml", "python3-numpy": "numpy",
-          "python3-matplotlib": "matplotlib", "gtest": "gtest", "libcli11-dev": "CLI"}
+          "python3-matplotlib": "matplotlib", "gtest": "gtest", "libcli11-dev": "CLI",
+          "libpcl-all-dev": "pcl"}
 # catkin components the code uses without including a header of their own.
 INDIRECT = {"tf2": "tf2:: functions and libtf2 through tf2_eigen's and tf2_ros' headers"}
 INSTALLED_SCRIPTS = ["scripts/tum_to_bag", "scripts/record_trajectory",

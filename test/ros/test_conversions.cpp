@@ -6,12 +6,14 @@
 
 #include <diagnostic_msgs/DiagnosticStatus.h>
 #include <gtest/gtest.h>
+#include <pcl_conversions/pcl_conversions.h>
 #include <sensor_msgs/image_encodings.h>
 
 #include "cause_throttle.hpp"
 #include "conversions.hpp"
 #include "covariance.hpp"
 #include "messages.hpp"
+#include "point_types.hpp"
 #include "ros_params.hpp"
 #include "stamp_check.hpp"
 
@@ -250,24 +252,49 @@ TEST(PoseMsg, RoundTripsAndRejectsZeroQuaternion) {
   EXPECT_NE(problem, "");
 }
 
-TEST(PointCloud2, PacksXyzAndRgb) {
+// The published cloud read back as a PCL user reads it: every channel through acvo's own
+// point type, the colour through pcl::PointXYZRGB (what rviz and most PCL code use).
+TEST(PointCloud2, ReadsBackThroughPclWithItsLabels) {
   acvo::LabelledCloud cloud;
   cloud.points = {{1.f, 2.f, 3.f}, {-1.f, 0.5f, 4.f}};
   cloud.rgb = {{{255, 128, 1}}, {{0, 0, 0}}};
+  acvo::Label l0, l1;
+  l0 << 0.1f, 0.2f, 0.3f, -0.4f, 0.5f;
+  l1 << 0.9f, 0.8f, 0.7f, 0.6f, -0.5f;
+  cloud.labels = {l0, l1};
   std_msgs::Header h;
   h.frame_id = "cam";
+  h.stamp = ros::Time(1305031102, 175304000);
   const sensor_msgs::PointCloud2 msg = toPointCloud2(cloud, h);
-  ASSERT_EQ(msg.width, 2u);
-  ASSERT_EQ(msg.fields.size(), 4u);
-  EXPECT_EQ(msg.fields[3].name, "rgb");
   EXPECT_EQ(msg.header.frame_id, "cam");
-  float v[4];
-  std::memcpy(v, &msg.data[msg.point_step], sizeof v);
-  EXPECT_EQ(v[0], -1.f);
-  EXPECT_EQ(v[2], 4.f);
-  std::uint32_t rgb = 0;
-  std::memcpy(&rgb, &msg.data[12], 4);
-  EXPECT_EQ(rgb, 0xff8001u);
+  EXPECT_EQ(msg.header.stamp, h.stamp) << "the stamp keeps its nanoseconds";
+  EXPECT_EQ(msg.width, 2u);
+  EXPECT_EQ(msg.height, 1u);
+  std::vector<std::string> names;
+  for (const auto& f : msg.fields) names.push_back(f.name);
+  EXPECT_EQ(names, (std::vector<std::string>{"x", "y", "z", "rgb", "hue", "saturation", "value",
+                                             "gradient_x", "gradient_y"}));
+  pcl::PointCloud<LabelledPoint> back;
+  pcl::fromROSMsg(msg, back);
+  ASSERT_EQ(back.size(), 2u);
+  EXPECT_EQ(back[1].x, -1.f);
+  EXPECT_EQ(back[1].z, 4.f);
+  EXPECT_EQ(back[0].r, 255);
+  EXPECT_EQ(back[0].g, 128);
+  EXPECT_EQ(back[0].b, 1);
+  for (int i = 0; i < 2; ++i) {
+    const acvo::Label& l = cloud.labels[std::size_t(i)];
+    EXPECT_EQ(back[i].hue, l[0]);
+    EXPECT_EQ(back[i].saturation, l[1]);
+    EXPECT_EQ(back[i].value, l[2]);
+    EXPECT_EQ(back[i].gradient_x, l[3]);
+    EXPECT_EQ(back[i].gradient_y, l[4]);
+  }
+  pcl::PointCloud<pcl::PointXYZRGB> rgb;
+  pcl::fromROSMsg(msg, rgb);
+  ASSERT_EQ(rgb.size(), 2u);
+  EXPECT_EQ(rgb[0].y, 2.f);
+  EXPECT_EQ(rgb[0].getRGBVector3i(), Eigen::Vector3i(255, 128, 1));
 }
 
 TEST(Covariance, ReordersRotationFirstToRosOrder) {

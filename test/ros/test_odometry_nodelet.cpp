@@ -21,6 +21,7 @@
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
 #include <rosgraph_msgs/Log.h>
+#include <pcl_conversions/pcl_conversions.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <std_srvs/Empty.h>
 #include <tf2_eigen/tf2_eigen.h>
@@ -33,6 +34,7 @@
 #include "conversions.hpp"
 #include "covariance.hpp"
 #include "nodelet_settings.hpp"
+#include "point_types.hpp"
 #include "synthetic_room.hpp"
 #include "test_messages.hpp"
 
@@ -545,14 +547,33 @@ TEST(OdometryNodelet, CloudIsPublishedToASubscriberInTheCameraFrame) {
     EXPECT_EQ(clouds[i].header.frame_id, acvo_ros::stripSlash(client->camera_frame_));
     ASSERT_TRUE(out[i].info);
     EXPECT_EQ(clouds[i].width, out[i].info->moving_points);
-    ASSERT_EQ(clouds[i].fields.size(), 4u);
-    EXPECT_EQ(clouds[i].fields[3].name, "rgb");
   }
-  // Points lie in the camera frame: in front of it, within the room's depth.
-  float xyz[3];
-  std::memcpy(xyz, clouds[0].data.data(), sizeof xyz);
-  EXPECT_GT(xyz[2], 0.5f);
-  EXPECT_LT(xyz[2], 6.0f);
+  // Read back as a PCL user would: every point in front of the camera within the room's depth,
+  // its labels those of a colour image (HSV in [0, 1], gradients in [-1, 1]), and not all alike.
+  pcl::PointCloud<acvo_ros::LabelledPoint> pc;
+  pcl::fromROSMsg(clouds[0], pc);
+  ASSERT_EQ(pc.size(), std::size_t{clouds[0].width});
+  ASSERT_GT(pc.size(), 100u);
+  float min_hue = 1.f, max_hue = 0.f, max_gradient = 0.f;
+  for (const auto& p : pc) {
+    EXPECT_GT(p.z, 0.5f);
+    EXPECT_LT(p.z, 6.0f);
+    for (float v : {p.hue, p.saturation, p.value}) {
+      EXPECT_GE(v, 0.f);
+      EXPECT_LE(v, 1.f);
+    }
+    EXPECT_LE(std::abs(p.gradient_x), 1.f);
+    EXPECT_LE(std::abs(p.gradient_y), 1.f);
+    min_hue = std::min(min_hue, p.hue);
+    max_hue = std::max(max_hue, p.hue);
+    max_gradient = std::max({max_gradient, std::abs(p.gradient_x), std::abs(p.gradient_y)});
+  }
+  EXPECT_LT(min_hue, max_hue) << "labels carry the image's colours";
+  EXPECT_GT(max_gradient, 0.f) << "selected points sit on intensity gradients";
+  pcl::PointCloud<pcl::PointXYZRGB> rgb;
+  pcl::fromROSMsg(clouds[0], rgb);
+  ASSERT_EQ(rgb.size(), pc.size());
+  EXPECT_EQ(rgb[0].rgb, pc[0].rgb);
 }
 
 TEST(OdometryNodelet, ResetReturnsToIdentityAndToAGivenPose) {
