@@ -15,11 +15,19 @@ namespace acvo::test {
 inline std::filesystem::path sourceDir() { return ACVO_SOURCE_DIR; }
 
 // ../shared/data beside the repository, or ACVO_SHARED_DATA when set. Empty when absent:
-// tests that need it call GTEST_SKIP() with a reason.
+// tests that need it call GTEST_SKIP() with a reason, as a user's machine has no such folder.
+// With ACVO_REQUIRE_SHARED_DATA=1 (.ci/run) an absent folder is also a failure of the test that
+// asked: CI can never pass with the real-data tests quietly skipped.
 inline std::filesystem::path sharedDataDir() {
   std::filesystem::path p = ACVO_SHARED_DATA_DIR;
   if (const char* env = std::getenv("ACVO_SHARED_DATA")) p = env;
-  return std::filesystem::is_directory(p) ? p : std::filesystem::path();
+  if (std::filesystem::is_directory(p)) return p;
+  const char* require = std::getenv("ACVO_REQUIRE_SHARED_DATA");
+  if (require && std::string(require) == "1") {
+    ADD_FAILURE() << "ACVO_REQUIRE_SHARED_DATA=1 and the shared data folder " << p
+                  << " is absent: this test needs its real frames";
+  }
+  return {};
 }
 
 // Folder of the built tools (acvo_synth, acvo_tum, acvo_eval).
