@@ -92,6 +92,14 @@ TEST(Odometry, BadFramesAreRejectedWithoutChangingTheState) {
   no_focal.camera.fx = 0.0;
   EXPECT_EQ(odo.process(no_focal).tracking, Tracking::kBadFrame);
 
+  for (double stamp : {std::nan(""), double(INFINITY)}) {
+    Frame bad_stamp = seq.frame(1).toFrame();
+    bad_stamp.stamp = stamp;
+    r = odo.process(bad_stamp);
+    EXPECT_EQ(r.tracking, Tracking::kBadFrame);
+    EXPECT_NE(r.message.find("stamp"), std::string::npos) << r.message;
+  }
+
   EXPECT_TRUE(odo.pose().isApprox(pose));
   // The reference survived: the next good frame tracks.
   r = odo.process(seq.frame(1).toFrame());

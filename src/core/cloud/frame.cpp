@@ -1,6 +1,7 @@
 // What makes a frame unusable (Frame::problem): sizes, types, intrinsics, stamp.
 #include "acvo/frame.hpp"
 
+#include <cmath>
 #include <sstream>
 
 namespace acvo {
@@ -24,6 +25,8 @@ std::string Frame::problem() const {
     return why.str();
   }
   if (!camera.valid()) return "camera intrinsics are invalid (zero or non-finite focal length)";
+  // A NaN stamp would enter every later interval and covariance growth until a reset.
+  if (!std::isfinite(stamp)) return "stamp is not finite";
   if (camera.width != color.cols || camera.height != color.rows) {
     why << "camera is " << camera.width << "x" << camera.height << " but the images are "
         << color.cols << "x" << color.rows;
