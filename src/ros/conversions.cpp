@@ -51,6 +51,12 @@ std::string layoutProblem(const sensor_msgs::Image& msg) {
     return "byte order of the data differs from this machine's (is_bigendian = " +
            std::to_string(msg.is_bigendian) + ")";
   }
+  // An image row starts on a whole element: cv::Mat (and every consumer of the data) assumes it.
+  const std::uint32_t element = static_cast<std::uint32_t>(std::max(bits / 8, 1));
+  if (msg.step % element != 0) {
+    return "step " + std::to_string(msg.step) + " is not a multiple of the " +
+           std::to_string(element) + "-byte element of " + msg.encoding;
+  }
   const std::uint64_t row_bytes = std::uint64_t{msg.width} * channels * bits / 8;
   if (msg.step < row_bytes) {
     return "step " + std::to_string(msg.step) + " is shorter than a row of " +

@@ -267,11 +267,22 @@ void OdometryNodelet::subscribe() {
 
 void OdometryNodelet::onFrame(const ImageConstPtr& rgb, const ImageConstPtr& depth,
                               const CameraInfoConstPtr& info) {
+  const auto start = std::chrono::steady_clock::now();
+  std::lock_guard<std::mutex> lock(mutex_);
   try {
-    std::lock_guard<std::mutex> lock(mutex_);
     processFrame(*rgb, *depth, *info);
   } catch (const std::exception& e) {
-    NODELET_ERROR_THROTTLE(5.0, "frame at %.6f skipped: %s", rgb->header.stamp.toSec(), e.what());
+    // Whatever threw (a decoder, a TF lookup, the odometry), the frame goes the way of every
+    // frame that is not processed: a named cause in odom_info and diagnostics.
+    std_msgs::Header header = rgb->header;
+    header.frame_id = stripSlash(rgb->header.frame_id);
+    try {
+      reject(header, std::string("unexpected error while processing the frame: ") + e.what(),
+             msSince(start));
+    } catch (const std::exception& again) {
+      NODELET_ERROR_THROTTLE(5.0, "frame at %.6f skipped: %s (and reporting it failed: %s)",
+                             rgb->header.stamp.toSec(), e.what(), again.what());
+    }
   }
 }
 

@@ -101,6 +101,24 @@ TEST(DecodeColor, HonoursRowPadding) {
   EXPECT_EQ(out.image.at<std::uint8_t>(1, 1), 4);
 }
 
+// A padded row that does not end on a whole element: cv::Mat would throw ("Step must be a
+// multiple of esz1"); the decoder names it instead, so that the frame goes the rejection way.
+TEST(DecodeDepth, RejectsAStepThatIsNotAWholeNumberOfElements) {
+  for (const auto& [encoding, bytes] :
+       {std::pair{enc::TYPE_16UC1, 2}, std::pair{enc::TYPE_32FC1, 4}}) {
+    sensor_msgs::Image m = image(encoding, 4, 3, bytes);
+    m.step = 4 * bytes + 1;
+    m.data.assign(std::size_t{m.step} * 3, 0);
+    const DepthImage out = decodeDepth(m);
+    EXPECT_NE(out.problem.find("not a multiple"), std::string::npos)
+        << encoding << ": " << out.problem;
+    EXPECT_TRUE(out.metres.empty());
+    m.step = 4 * bytes + bytes;  // padding of a whole element is fine
+    m.data.assign(std::size_t{m.step} * 3, 0);
+    EXPECT_EQ(decodeDepth(m).problem, "") << encoding;
+  }
+}
+
 TEST(DecodeDepth, MillimetresAndMetresGiveTheSameMetres) {
   sensor_msgs::Image mm = image(enc::TYPE_16UC1, 3, 1, 2);
   const std::uint16_t raw[3] = {1500, 0, 65535};

@@ -852,6 +852,13 @@ TEST(OdometryNodelet, BadInputIsNamedAndSkippedAndTheNodeCarriesOn) {
       {"truncated colour", [](auto& c, auto&, auto&) { c.data.resize(c.data.size() / 2); },
        "truncated"},
       {"short step", [](auto&, auto& d, auto&) { d.step = d.width; }, "step"},
+      // A row that does not end on a whole element (cv::Mat would throw on it).
+      {"odd step",
+       [](auto&, auto& d, auto&) {
+         d.step += 1;
+         d.data.resize(std::size_t{d.step} * d.height);
+       },
+       "not a multiple"},
       {"size mismatch",
        [](auto&, auto& d, auto&) {
          d.width /= 2;
