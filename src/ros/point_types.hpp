@@ -7,6 +7,14 @@
 #include <pcl/point_types.h>
 #include <pcl/register_point_struct.h>
 
+// PCL's point macros declare anonymous structs inside unions (a GNU extension that GCC and
+// clang accept); clang's pedantic diagnostics name them in PCL's own macros, not in this code.
+#if defined(__clang__)
+#pragma clang diagnostic push
+#pragma clang diagnostic ignored "-Wgnu-anonymous-struct"
+#pragma clang diagnostic ignored "-Wnested-anon-types"
+#endif
+
 namespace acvo_ros {
 
 struct EIGEN_ALIGN16 LabelledPoint {
@@ -21,6 +29,10 @@ struct EIGEN_ALIGN16 LabelledPoint {
 };
 
 }  // namespace acvo_ros
+
+#if defined(__clang__)
+#pragma clang diagnostic pop
+#endif
 
 POINT_CLOUD_REGISTER_POINT_STRUCT(acvo_ros::LabelledPoint,
                                   (float, x, x)(float, y, y)(float, z, z)(float, rgb, rgb)(

@@ -8,7 +8,7 @@
 // shown; every frame goes to every method in turn (the order rotating), so that a machine that
 // slows down or speeds up during the run does so for all of them; --repeat gives the median of
 // the per-run medians and their spread.
-#include <time.h>
+#include <ctime>
 
 #include <algorithm>
 #include <chrono>

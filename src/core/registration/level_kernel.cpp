@@ -102,7 +102,7 @@ const LevelSums& LevelKernel::evaluate(const Eigen::Isometry3d& T, double ell) {
         for (int q = 0; q < m; ++q) {
           if (!(d2[q] < r2) || a[q] < sp) continue;
           const float aq = a[q];
-          x_sum += aq * X[std::size_t(chunk.i[std::size_t(k + q)])];
+          x_sum += aq * X[std::size_t(chunk.i[std::size_t(k) + std::size_t(q)])];
           a_sum += aq;
           ++s.nnz;
         }

@@ -106,7 +106,7 @@ const CrossSums& PaperKernel::evaluate(const Eigen::Isometry3d& T, double ell) {
         a = sigma2 * (d2 * -inv).exp() * Map(cand.color.data() + k, m);
         for (int q = 0; q < m; ++q) {
           if (!(d2[q] < r2) || a[q] < sp) continue;
-          const int i = cand.i[std::size_t(k + q)];
+          const int i = cand.i[std::size_t(k) + std::size_t(q)];
           const float aq = a[q];
           out.pairs.push_back({i, aq});
           const Eigen::Vector3f& x = X[std::size_t(i)];
