@@ -95,6 +95,12 @@ class RegistrationEngine {
   virtual int minPoints() const = 0;
 };
 
+// What both engines check before registering: kTooFewPoints when either cloud has fewer than
+// `min_points`, kNotFinite for a guess that is not finite; nullopt when the input is usable.
+// Throws std::logic_error when `fixed` was not prepared as a reference.
+std::optional<SolverStatus> inputProblem(const PreparedCloud& fixed, const PreparedCloud& moving,
+                                         const Eigen::Isometry3d& guess, int min_points);
+
 // The engine Params::registration.engine names, with its parameters.
 std::unique_ptr<RegistrationEngine> makeRegistrationEngine(const Params& params);
 

@@ -6,7 +6,6 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
-#include <stdexcept>
 
 #include <Eigen/Cholesky>
 
@@ -101,15 +100,9 @@ SolverResult alignCoarseToFine(const CoarseToFineCloud& fixed, const CoarseToFin
   result.transform = guess;
   const std::vector<double> ells = levelElls(p);
   result.ell = ells.back();
-  if (int(fixed.size()) < p.min_points || int(moving.size()) < p.min_points) {
-    result.status = SolverStatus::kTooFewPoints;
-    result.ms_total = msSince(t_start);
-    return result;
-  }
-  if (!fixed.reference) throw std::logic_error("align: the fixed cloud is not a reference");
-  if (!guess.matrix().allFinite()) {
-    result.status = SolverStatus::kNotFinite;
-    result.transform = Eigen::Isometry3d::Identity();
+  if (const auto problem = inputProblem(fixed, moving, guess, p.min_points)) {
+    result.status = *problem;
+    if (*problem == SolverStatus::kNotFinite) result.transform = Eigen::Isometry3d::Identity();
     result.ms_total = msSince(t_start);
     return result;
   }

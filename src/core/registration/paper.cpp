@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <stdexcept>
 
 #include "acvo/covariance.hpp"
 
@@ -156,15 +155,9 @@ SolverResult alignPaper(const PaperCloud& fixed, const PaperCloud& moving,
   SolverResult result;
   result.transform = guess;
   result.ell = firstEll(p);
-  if (int(fixed.size()) < p.min_points || int(moving.size()) < p.min_points) {
-    result.status = SolverStatus::kTooFewPoints;
-    result.ms_total = msSince(t_start);
-    return result;
-  }
-  if (!fixed.reference) throw std::logic_error("align: the fixed cloud is not a reference");
-  if (!guess.matrix().allFinite()) {
-    result.status = SolverStatus::kNotFinite;
-    result.transform = Eigen::Isometry3d::Identity();
+  if (const auto problem = inputProblem(fixed, moving, guess, p.min_points)) {
+    result.status = *problem;
+    if (*problem == SolverStatus::kNotFinite) result.transform = Eigen::Isometry3d::Identity();
     result.ms_total = msSince(t_start);
     return result;
   }

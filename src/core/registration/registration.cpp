@@ -1,6 +1,8 @@
 // The engines behind one interface: picking one by name, and what their results share.
 #include "acvo/registration.hpp"
 
+#include <stdexcept>
+
 #include "acvo/registration/coarse_to_fine.hpp"
 #include "acvo/registration/paper.hpp"
 
@@ -18,6 +20,16 @@ std::string toString(SolverStatus s) {
       return "not_finite";
   }
   return "unknown";
+}
+
+std::optional<SolverStatus> inputProblem(const PreparedCloud& fixed, const PreparedCloud& moving,
+                                         const Eigen::Isometry3d& guess, int min_points) {
+  if (int(fixed.size()) < min_points || int(moving.size()) < min_points) {
+    return SolverStatus::kTooFewPoints;
+  }
+  if (!fixed.reference) throw std::logic_error("align: the fixed cloud is not a reference");
+  if (!guess.matrix().allFinite()) return SolverStatus::kNotFinite;
+  return std::nullopt;
 }
 
 std::unique_ptr<RegistrationEngine> makeRegistrationEngine(const Params& params) {
