@@ -36,9 +36,15 @@ struct OdometryResult {
   Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
   double interval = 0.0;  // s from the last tracked frame to this one (0: first or bad frame)
   // Covariance of this frame's registration (T: current -> keyframe, in the keyframe camera's
-  // axes), which is also used for `motion`: covariance_scale * (-H)^-1 (motionCovariance),
-  // times 10 when tracking is hard; kLostVariance on the diagonal when lost.
-  Matrix6d motion_covariance = Matrix6d::Identity();
+  // axes): covariance_scale * (-H)^-1 (scaledInverseInformation), times 10 when tracking is
+  // hard; kLostVariance on the diagonal when lost.
+  Matrix6d registration_covariance = lostCovariance();
+  // Covariance of `motion` (T: current -> last tracked, in the last tracked camera's axes): the
+  // registration's when the last tracked frame is the keyframe; otherwise both registrations
+  // to the keyframe (this frame's and the last tracked frame's) carried through
+  // motion = last_to_keyframe^-1 * to_keyframe (frameMotionCovariance). kLostVariance when not
+  // tracked.
+  Matrix6d motion_covariance = lostCovariance();
   // Frames are numbered from 0 in the order processed (bad frames get no number).
   std::uint64_t frame_index = 0;
   std::uint64_t keyframe_index = 0;  // the keyframe this frame was registered to
@@ -73,6 +79,14 @@ struct Judgement {
 };
 Judgement judgeTracking(const SolverResult& s, const Eigen::Isometry3d& frame_motion,
                         const OdometryParams& params);
+
+// Covariance of motion = last^-1 * current (both T: camera -> keyframe camera, each with its
+// registration's covariance, left perturbations in the keyframe camera's axes), in the last
+// camera's axes: Ad(last^-1) (current_cov + last_cov) Ad(last^-1)^T. The two registrations are
+// taken as independent; both were made against the same keyframe cloud, so their errors are
+// positively correlated and the sum is an upper bound on what the difference can be off by.
+Matrix6d frameMotionCovariance(const Eigen::Isometry3d& last, const Matrix6d& last_cov,
+                               const Matrix6d& current_cov);
 
 // The constant-velocity guess for a frame `interval` seconds after the last tracked frame, from
 // the last motion, measured over `measured` seconds: that motion scaled down in proportion when
@@ -133,6 +147,7 @@ class Odometry {
     Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();         // camera in the odometry frame
     Matrix6d covariance = Matrix6d::Zero();                         // of pose
     Eigen::Isometry3d to_keyframe = Eigen::Isometry3d::Identity();  // camera -> keyframe camera
+    Matrix6d to_keyframe_covariance = Matrix6d::Zero();             // of to_keyframe
   };
   struct Registration;
   // The steps of process(), in order.

@@ -21,6 +21,11 @@ Eigen::Vector3d logSO3(const Eigen::Matrix3d& R);
 Eigen::Isometry3d expSE3(const Vector6d& xi);
 Vector6d logSE3(const Eigen::Isometry3d& T);
 
+// Adjoint of T for twists (omega, v): Ad(T) xi is the twist xi seen through T, so that
+// T exp(xi^) = exp((Ad(T) xi)^) T. Block form [R 0; hat(t) R  R]. A covariance C of a left
+// perturbation maps to Ad C Ad^T when the pose is multiplied by T on the left.
+Matrix6d adjointSE3(const Eigen::Isometry3d& T);
+
 // Re-orthonormalises the rotation part (guards long chains of products against drift).
 Eigen::Isometry3d normalized(const Eigen::Isometry3d& T);
 

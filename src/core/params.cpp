@@ -207,7 +207,8 @@ std::string validate(const Params& p) {
   check(why, a.hard_ell_reductions > 0, "paper.hard_ell_reductions", "must be positive");
   check(why, a.covariance_scale > 0.0, "paper.covariance_scale", "must be positive");
   const OdometryParams& od = p.odometry;
-  check(why, od.threads >= 0, "odometry.threads", "must not be negative (0 = all cores)");
+  check(why, od.threads >= -1, "odometry.threads",
+        "must be -1 (all cores but one), 0 (all cores) or a number of threads");
   check(why,
         od.lost_matched_fraction >= 0.0 && od.lost_matched_fraction <= od.hard_matched_fraction,
         "odometry.lost_matched_fraction", "must lie within [0, hard_matched_fraction]");

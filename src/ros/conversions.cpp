@@ -4,6 +4,7 @@
 #include <cstring>
 #include <stdexcept>
 
+#include <image_geometry/pinhole_camera_model.h>
 #include <pcl_conversions/pcl_conversions.h>
 #include <sensor_msgs/image_encodings.h>
 #include <tf2_eigen/tf2_eigen.h>
@@ -158,23 +159,43 @@ CameraResult cameraFor(const sensor_msgs::CameraInfo& info, int width, int heigh
     cam.cx = (cam.cx + 0.5) * sx - 0.5;
     cam.cy = (cam.cy + 0.5) * sy - 0.5;
   } else {
-    const auto& K = info.K;
-    if (!(K[0] > 0.0 && K[4] > 0.0 && std::isfinite(K[0]) && std::isfinite(K[4]) &&
-          std::isfinite(K[2]) && std::isfinite(K[5]))) {
-      out.problem = "camera_info K has a zero, negative or non-finite focal length or centre (fx " +
-                    std::to_string(K[0]) + ", fy " + std::to_string(K[4]) + ")";
+    // image_geometry reads camera_info as the ROS drivers mean it: the projection matrix P
+    // (the rectified image's intrinsics, which K is not for a distorted camera), scaled for
+    // binning and shifted for a region of interest.
+    image_geometry::PinholeCameraModel model;
+    try {
+      model.fromCameraInfo(info);
+    } catch (const std::exception& e) {
+      out.problem = std::string("camera_info cannot be read: ") + e.what();
       return out;
     }
-    if (static_cast<int>(info.width) != width || static_cast<int>(info.height) != height) {
+    const cv::Size reduced = model.reducedResolution();
+    if (reduced.width != width || reduced.height != height) {
+      const bool scaled = info.binning_x > 1 || info.binning_y > 1 || info.roi.width > 0;
       out.problem = "camera_info size " + std::to_string(info.width) + "x" +
-                    std::to_string(info.height) + " differs from the image's " +
-                    std::to_string(width) + "x" + std::to_string(height);
+                    std::to_string(info.height) +
+                    (scaled ? " (" + std::to_string(reduced.width) + "x" +
+                                  std::to_string(reduced.height) + " after binning and ROI)"
+                            : std::string()) +
+                    " differs from the image's " + std::to_string(width) + "x" +
+                    std::to_string(height);
       return out;
     }
-    cam.fx = K[0];
-    cam.fy = K[4];
-    cam.cx = K[2];
-    cam.cy = K[5];
+    // A driver that fills K alone (P all zero): K, adjusted alike.
+    const bool has_p = info.P[0] != 0.0 || info.P[5] != 0.0;
+    const cv::Matx33d k = has_p ? model.projectionMatrix().get_minor<3, 3>(0, 0)
+                                : model.intrinsicMatrix();
+    cam.fx = k(0, 0);
+    cam.fy = k(1, 1);
+    cam.cx = k(0, 2);
+    cam.cy = k(1, 2);
+    if (!(cam.fx > 0.0 && cam.fy > 0.0 && std::isfinite(cam.fx) && std::isfinite(cam.fy) &&
+          std::isfinite(cam.cx) && std::isfinite(cam.cy))) {
+      out.problem = std::string("camera_info ") + (has_p ? "P" : "K") +
+                    " has a zero, negative or non-finite focal length or centre (fx " +
+                    std::to_string(cam.fx) + ", fy " + std::to_string(cam.fy) + ")";
+      return out;
+    }
   }
   cam.width = width;
   cam.height = height;

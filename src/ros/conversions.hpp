@@ -61,8 +61,9 @@ struct CameraResult {
   std::string problem;
 };
 // Intrinsics of a width x height colour image: explicit override, else the named camera
-// (scaled when the image is not 640x480), else CameraInfo's K (whose size must match the image
-// and whose focal lengths must be positive).
+// (scaled when the image is not 640x480), else CameraInfo's projection matrix P through
+// image_geometry::PinholeCameraModel (binning and ROI applied; K when P is all zero), whose
+// size after binning and ROI must match the image and whose focal lengths must be positive.
 CameraResult cameraFor(const sensor_msgs::CameraInfo& info, int width, int height,
                        const IntrinsicsOverride& override_intrinsics);
 

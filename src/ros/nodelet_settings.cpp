@@ -1,6 +1,8 @@
 #include "nodelet_settings.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <sstream>
 #include <stdexcept>
 
@@ -82,7 +84,92 @@ std::string frameId(const XmlRpcValue& ns, const std::string& key, const std::st
   return stripSlash(id);
 }
 
+// The settings loadNodeletSettings reads, and the other top-level keys the nodelet reads.
+const char* const kTopLevelKeys[] = {
+    "odom_frame_id", "base_frame_id", "guess_frame_id", "base_is_optical_frame", "publish_tf",
+    "approx_sync", "wait_for_transform_duration", "max_time_gap", "no_data_timeout",
+    "approx_sync_max_interval", "topic_queue_size", "queue_size", "sync_queue_size", "lost_odom",
+    "publish_null_when_lost", "camera", "fx", "fy", "cx", "cy", "initial_pose",
+    // the parameter sections (ros_params.hpp), the old one it reports, the transport hints
+    "selection", "registration", "coarse_to_fine", "paper", "odometry", "solver",
+    "image_transport", "depth_image_transport"};
+
+// Other nodes' names for a setting, and what it is here.
+const std::pair<const char*, const char*> kAliases[] = {
+    {"frame_id", "base_frame_id"},
+    {"child_frame_id", "base_frame_id"},
+    {"wait_for_transform", "wait_for_transform_duration"},
+    {"rgb/image_transport", "image_transport"},
+    {"depth/image_transport", "depth_image_transport"},
+    {"publish_tf_odom", "publish_tf"},
+};
+
+// Levenshtein distance (two rows). Written out: none of the libraries here offers one for
+// strings, and a dozen lines beat a dependency.
+std::size_t editDistance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> prev(b.size() + 1), cur(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) prev[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    cur[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t substitute = prev[j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1);
+      cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, substitute});
+    }
+    std::swap(prev, cur);
+  }
+  return prev[b.size()];
+}
+
 }  // namespace
+
+std::string closeMatchHint(const std::string& name, const std::vector<std::string>& known) {
+  const std::size_t allowed = std::max<std::size_t>(2, name.size() / 4);
+  std::size_t best = allowed + 1;
+  std::string match;
+  for (const std::string& k : known) {
+    const std::size_t d = editDistance(name, k);
+    if (d < best) {
+      best = d;
+      match = k;
+    }
+  }
+  return match.empty() ? std::string() : " (did you mean ~" + match + "?)";
+}
+
+std::vector<std::string> unknownParameters(const XmlRpc::XmlRpcValue& private_ns,
+                                           const std::vector<std::string>& also_known) {
+  std::vector<std::string> problems;
+  if (private_ns.getType() != XmlRpcValue::TypeStruct) return problems;
+  std::vector<std::string> known(std::begin(kTopLevelKeys), std::end(kTopLevelKeys));
+  known.insert(known.end(), also_known.begin(), also_known.end());
+  const auto report = [&](const std::string& name) {
+    for (const auto& [alias, here] : kAliases) {
+      if (name == alias) {
+        problems.push_back("unknown parameter ~" + name + " (ignored): this node calls it ~" +
+                           here);
+        return;
+      }
+    }
+    if (name.rfind("Odom", 0) == 0 || name.rfind("Reg/", 0) == 0 || name.rfind("Vis/", 0) == 0) {
+      problems.push_back("unknown parameter ~" + name +
+                         " (ignored): rtabmap's parameters are not read here; acvo's are "
+                         "~selection/, ~registration/, ~coarse_to_fine/ and ~odometry/ "
+                         "(config/acvo.yaml)");
+      return;
+    }
+    problems.push_back("unknown parameter ~" + name + " (ignored)" + closeMatchHint(name, known));
+  };
+  for (const auto& [key, value] : private_ns) {
+    if (std::find(known.begin(), known.end(), key) != known.end()) continue;
+    if (value.getType() == XmlRpcValue::TypeStruct && value.size() > 0) {
+      // A namespace of its own (rgb/image_transport, rtabmap's Odom/Strategy): name its keys.
+      for (const auto& inner : value) report(key + "/" + inner.first);
+    } else {
+      report(key);
+    }
+  }
+  return problems;
+}
 
 std::string toString(LostOdom v) {
   switch (v) {

@@ -14,11 +14,12 @@
 
 namespace acvo_ros {
 
-// What the nodelet publishes for a lost frame.
+// What the nodelet publishes on `odom` for a lost frame. TF goes on in every case, with the
+// pose held or following the motion guess (odom_continuity.hpp): the frame tree never stops.
 enum class LostOdom {
-  kHeld,  // the held pose, its covariance grown by what it may be wrong by; twist unknown (1e6)
+  kHeld,  // the held (or dead-reckoned) pose, its covariance grown; twist unknown (1e6)
   kNull,  // rtabmap's publish_null_when_lost: a zero pose (all-zero quaternion), 1e6 variances
-  kNone,  // nothing (no odom, no TF)
+  kNone,  // no odometry message
 };
 std::string toString(LostOdom v);
 // Throws std::invalid_argument listing the accepted values ("held", "null", "none").
@@ -60,6 +61,19 @@ struct NodeletSettings {
 // meaning: true = lost_odom null, false = none) with what they were taken as.
 std::vector<std::string> loadNodeletSettings(const XmlRpc::XmlRpcValue& private_ns,
                                              NodeletSettings& settings);
+
+// One sentence per parameter of the private namespace that nothing reads (a typo, another
+// node's name for a setting), each with the nearest known name or what it is called here:
+// `frame_id` is ~base_frame_id, `wait_for_transform` ~wait_for_transform_duration,
+// `rgb/image_transport` ~image_transport, rtabmap's `Odom/...` are not read. Known: the
+// settings above, the parameter sections (applyRosParams checks inside them), the transport
+// hints and `also_known` (dynamic_reconfigure's names, which its server writes here).
+std::vector<std::string> unknownParameters(const XmlRpc::XmlRpcValue& private_ns,
+                                           const std::vector<std::string>& also_known);
+
+// " (did you mean ~x?)" naming the entry of `known` closest to `name` in edit distance, when one
+// is close (at most a quarter of the name's letters, and at least 2, apart); "" otherwise.
+std::string closeMatchHint(const std::string& name, const std::vector<std::string>& known);
 
 // "x y z roll pitch yaw" -> pose; nullopt (and a sentence in *problem) when it is not six
 // finite numbers.

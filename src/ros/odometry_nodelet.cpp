@@ -13,6 +13,7 @@
 #include <optional>
 #include <string>
 #include <variant>
+#include <vector>
 
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <dynamic_reconfigure/server.h>
@@ -42,6 +43,7 @@
 #include "covariance.hpp"
 #include "messages.hpp"
 #include "nodelet_settings.hpp"
+#include "odom_continuity.hpp"
 #include "ros_params.hpp"
 #include "stamp_check.hpp"
 
@@ -51,7 +53,8 @@ using sensor_msgs::CameraInfoConstPtr;
 using sensor_msgs::ImageConstPtr;
 
 namespace {
-// A stamp earlier than the last one by more than this (s) is a restarted bag, not a reordering.
+// A stamp earlier than the last one by more than this (s) is a restarted stream, not a
+// reordering (StampGuard also tells a shorter jump back from a reordering).
 constexpr double kTimeJumpBack = 1.0;
 // Warn when the synchroniser has produced nothing for this long (wall seconds).
 constexpr double kNoSyncWarning = 5.0;
@@ -95,7 +98,8 @@ class OdometryNodelet : public nodelet::Nodelet {
                                           const ros::Time& stamp, double wait, std::string* error);
   std::optional<Eigen::Isometry3d> baseFromCamera();
   FrameTf frameTf(const ros::Time& stamp);
-  void publish(const acvo::OdometryResult& r, const std_msgs::Header& header, const FrameTf& tf);
+  void publish(const acvo::OdometryResult& r, const ContinuousOdom::Pose& pose,
+               const std_msgs::Header& header, const FrameTf& tf);
   void publishInfo(const acvo::OdometryResult& r, const std_msgs::Header& header,
                    const InfoExtras& extras);
   void restart(const Eigen::Isometry3d& camera_pose);
@@ -111,6 +115,9 @@ class OdometryNodelet : public nodelet::Nodelet {
 
   // Set in onInit; lost_odom also by dynamic_reconfigure.
   NodeletSettings settings_;
+  // What loading the parameters found wrong: logged once, and kept in diagnostics for whoever
+  // looks later.
+  std::vector<std::string> parameter_problems_;
   InputTopics topics_;
 
   ros::NodeHandle nh_, pnh_;
@@ -147,19 +154,25 @@ class OdometryNodelet : public nodelet::Nodelet {
     ros::WallTime wall;  // last synchronised frame, good or bad
   };
 
-  // State, guarded by mutex_ (frames, services, reconfigure and timers may run concurrently
-  // when the manager has several worker threads).
+  // State, guarded by mutex_. Every callback here (frames, services, reconfigure, the watchdog)
+  // comes through getNodeHandle()/getPrivateNodeHandle(), whose queue a nodelet manager serves
+  // one callback at a time: they never overlap today, and a frame that waits blocks all of them
+  // (hence no per-frame TF wait). The mutex keeps the state safe should one move to the
+  // multi-threaded handle.
   std::mutex mutex_;
   acvo::Params params_;
   std::unique_ptr<acvo::Odometry> odometry_;
   bool paused_ = false;
   std::string camera_frame_;                           // optical frame of the last image
   std::optional<Eigen::Isometry3d> base_from_camera_;  // looked up once per camera frame
+  bool base_waited_ = false;  // waited once for base_from_camera_ (per camera frame)
+  bool frame_ids_warned_ = false;
+  ContinuousOdom continuous_;  // the published pose (odom_continuity.hpp)
   // A base pose to start from (initial_pose, or reset_odom_to_pose before the camera-to-base
   // transform was known): applied at the first frame whose transform is known.
   std::optional<Eigen::Isometry3d> pending_base_pose_;
   bool guess_found_ = true;  // the last lookup of guess_frame_id succeeded: worth waiting for
-  ros::Time last_stamp_;     // stamp of the last frame processed
+  StampGuard stamps_;        // the stamps processed so far
   std::optional<std::uint64_t> published_keyframe_;  // last keyframe sent on keyframe_cloud
   Counters count_;
   LastFrame last_;
@@ -207,16 +220,28 @@ void OdometryNodelet::loadSettings() {
   ros::param::get(pnh_.getNamespace(), private_ns);
   for (const std::string& problem : loadNodeletSettings(private_ns, settings_)) {
     NODELET_ERROR("parameter problem: %s", problem.c_str());
+    parameter_problems_.push_back(problem);
   }
   NODELET_INFO("nodelet settings: %s", describe(settings_).c_str());
   pending_base_pose_ = settings_.initial_pose;
+  std::vector<std::string> reconfigurable;
+  for (const auto& d : acvo::AcvoConfig::__getParamDescriptions__()) {
+    reconfigurable.push_back(d->name);
+  }
+  for (const std::string& problem : unknownParameters(private_ns, reconfigurable)) {
+    NODELET_WARN("%s", problem.c_str());
+    parameter_problems_.push_back(problem);
+  }
 
   acvo::Params params;
+  // The nodelet shares its manager with the camera driver: leave it a core unless told.
+  params.odometry.threads = -1;
+  // Each value is checked by itself: a bad one is rejected with its reason, the rest are kept.
   for (const std::string& problem : applyRosParams(private_ns, params)) {
     NODELET_ERROR("parameter problem: %s", problem.c_str());
+    parameter_problems_.push_back(problem);
   }
-  const std::string invalid = acvo::validate(params);
-  if (!invalid.empty()) {
+  if (const std::string invalid = acvo::validate(params); !invalid.empty()) {
     NODELET_ERROR("invalid parameters (%s): using the defaults of acvo::Params instead",
                   invalid.c_str());
     params = acvo::Params();
@@ -314,9 +339,20 @@ void OdometryNodelet::processFrame(const Image& rgb, const Image& depth, const I
     NODELET_WARN_ONCE("%s has non-zero distortion: the images are used as if rectified",
                       topics_.info.c_str());
   }
+  const std::string depth_frame = stripSlash(depth.header.frame_id);
+  if (!frame_ids_warned_ && depth_frame != header.frame_id) {
+    frame_ids_warned_ = true;
+    NODELET_WARN(
+        "the depth image's frame_id '%s' differs from the colour image's '%s': the depth is "
+        "taken as registered to the colour camera (pixel for pixel, in '%s'). Right for TUM "
+        "bags, whose registered depth keeps the depth sensor's name, and for drivers' "
+        "depth_registered topics; wrong for a raw depth image (use the registered one)",
+        depth_frame.c_str(), header.frame_id.c_str(), header.frame_id.c_str());
+  }
   if (header.frame_id != camera_frame_) {
     camera_frame_ = header.frame_id;
     base_from_camera_.reset();
+    base_waited_ = false;
   }
 
   FrameTf tf = frameTf(header.stamp);
@@ -324,8 +360,12 @@ void OdometryNodelet::processFrame(const Image& rgb, const Image& depth, const I
     startAt(*pending_base_pose_, *tf.base_from_camera);
     tf.motion_guess.reset();
   }
-  const acvo::OdometryResult r = odometry_->process(frame, tf.motion_guess);
+  acvo::OdometryResult r = odometry_->process(frame, tf.motion_guess);
   ++count_.frames;
+  if (!tf.base_from_camera && r.tracking != acvo::Tracking::kBadFrame) {
+    r.message += std::string(r.message.empty() ? "" : "; ") + "not published: no transform from '" +
+                 baseFrame() + "' to '" + camera_frame_ + "' yet";
+  }
   last_.tracking = r.tracking;
   last_.message = r.message;
   InfoExtras extras;
@@ -335,17 +375,20 @@ void OdometryNodelet::processFrame(const Image& rgb, const Image& depth, const I
     reject(header, r.message, msSince(start));
     return;
   }
-  last_stamp_ = header.stamp;
+  stamps_.processed(header.stamp.toSec());
+  const ContinuousOdom::Pose pose =
+      continuous_.update(r, tf.motion_guess, header.stamp.toSec(), params_.odometry);
 
   if (r.tracking == acvo::Tracking::kLost) {
     ++count_.lost;
-    NODELET_WARN_THROTTLE(2.0, "tracking lost (%s): holding the last pose, %s (%u lost so far)",
-                          r.message.c_str(),
+    NODELET_WARN_THROTTLE(2.0, "tracking lost (%s): %s, %s (%u lost so far)", r.message.c_str(),
+                          tf.motion_guess ? "the pose follows the motion guess"
+                                          : "holding the last pose",
                           r.new_keyframe ? "the reference restarts from this frame"
                                          : "the next frame is registered to the last good one",
                           count_.lost);
   }
-  publish(r, header, tf);
+  publish(r, pose, header, tf);
   // On the ROS clock, as the stamps are: sim time when a bag is played with --clock.
   extras.ms_latency = (ros::Time::now() - header.stamp).toSec() * 1000.0;
   extras.ms_total = msSince(start);
@@ -354,8 +397,8 @@ void OdometryNodelet::processFrame(const Image& rgb, const Image& depth, const I
 }
 
 bool OdometryNodelet::acceptStamp(const ros::Time& stamp) {
-  const double last = last_stamp_.toSec();
-  switch (checkStamp(last, stamp.toSec(), settings_.max_time_gap, kTimeJumpBack)) {
+  const double last = stamps_.last();
+  switch (stamps_.check(stamp.toSec(), settings_.max_time_gap, kTimeJumpBack)) {
     case StampVerdict::kAccept:
       return true;
     case StampVerdict::kGap:
@@ -369,10 +412,24 @@ bool OdometryNodelet::acceptStamp(const ros::Time& stamp) {
                             stamp.toSec(), last);
       return false;
     case StampVerdict::kRestart:
-      NODELET_WARN("time jumped back by %.3f s (bag restarted?): odometry restarts at identity",
-                   last - stamp.toSec());
-      restart(Eigen::Isometry3d::Identity());
-      last_stamp_ = ros::Time();
+      if (ros::Time::isSimTime()) {
+        // A bag played again (rosbag play --loop --clock): the run starts over, from the start
+        // pose as the first time.
+        NODELET_WARN("time jumped back by %.3f s on the simulated clock (bag restarted?): "
+                     "odometry restarts at %s",
+                     last - stamp.toSec(), settings_.initial_pose ? "initial_pose" : "the origin");
+        restart(Eigen::Isometry3d::Identity());
+        pending_base_pose_ = settings_.initial_pose;
+      } else {
+        // A live camera (a driver restart, a clock step): the robot has not gone back to the
+        // origin. Keep the pose, restart the reference from this frame.
+        NODELET_WARN("time jumped back by %.3f s on the wall clock (driver restarted, clock "
+                     "stepped?): the pose is kept, tracking restarts from this frame",
+                     last - stamp.toSec());
+        odometry_->reset(odometry_->pose(), odometry_->poseCovariance());
+        published_keyframe_.reset();
+      }
+      stamps_.clear();
       return true;
   }
   return false;
@@ -424,14 +481,17 @@ std::optional<Eigen::Isometry3d> OdometryNodelet::baseFromCamera() {
   if (base_from_camera_) return base_from_camera_;
   const std::string base = baseFrame();
   std::string error;
-  base_from_camera_ =
-      lookup(base, camera_frame_, ros::Time(0), settings_.wait_for_transform_duration, &error);
+  // Wait for it once (the static transform may come a moment after the first image), then only
+  // look: waiting frame after frame would stall the callback queue.
+  const double wait = base_waited_ ? 0.0 : settings_.wait_for_transform_duration;
+  base_waited_ = true;
+  base_from_camera_ = lookup(base, camera_frame_, ros::Time(0), wait, &error);
   if (base_from_camera_) {
     NODELET_INFO("camera '%s' in base '%s': looked up once", camera_frame_.c_str(), base.c_str());
   } else {
     NODELET_ERROR_THROTTLE(5.0,
                            "no transform from base frame '%s' to camera frame '%s' (%s): "
-                           "odometry is not published until it is available",
+                           "odometry runs but is not published until it is available",
                            base.c_str(), camera_frame_.c_str(), error.c_str());
   }
   return base_from_camera_;
@@ -470,30 +530,38 @@ OdometryNodelet::FrameTf OdometryNodelet::frameTf(const ros::Time& stamp) {
   return tf;
 }
 
-void OdometryNodelet::publish(const acvo::OdometryResult& r, const std_msgs::Header& header,
-                              const FrameTf& tf) {
+void OdometryNodelet::publish(const acvo::OdometryResult& r, const ContinuousOdom::Pose& pose,
+                              const std_msgs::Header& header, const FrameTf& tf) {
   if (!tf.base_from_camera) return;
   const Eigen::Isometry3d& base_from_camera = *tf.base_from_camera;
   const std::string base = baseFrame();
   std_msgs::Header odom_header;
   odom_header.stamp = header.stamp;
   odom_header.frame_id = settings_.odom_frame_id;
+  // The published pose is continuous through losses (odom_continuity.hpp).
+  acvo::OdometryResult published = r;
+  published.pose = pose.pose;
+  published.pose_covariance = pose.covariance;
   const bool lost = r.tracking == acvo::Tracking::kLost;
   if (lost && settings_.lost_odom == LostOdom::kNull) {
     odom_pub_.publish(nullOdometryMsg(odom_header, base));
   } else if (!(lost && settings_.lost_odom == LostOdom::kNone)) {
-    odom_pub_.publish(toOdometryMsg(r, base_from_camera, odom_header, base));
-    const Eigen::Isometry3d base_pose = conjugate(base_from_camera, r.pose);
-    if (settings_.publish_tf && settings_.guess_frame_id.empty()) {
-      tf_broadcaster_->sendTransform(
-          toTransformMsg(base_pose, settings_.odom_frame_id, base, header.stamp));
-    } else if (settings_.publish_tf && tf.guess_from_base) {
-      // odom -> guess -> base: the correction of the guess frame, so that the chain gives the
-      // estimate and the base keeps its one parent (the wheel odometry's frame).
-      tf_broadcaster_->sendTransform(toTransformMsg(base_pose * tf.guess_from_base->inverse(),
-                                                    settings_.odom_frame_id,
-                                                    settings_.guess_frame_id, header.stamp));
-    }
+    odom_pub_.publish(toOdometryMsg(published, base_from_camera, odom_header, base));
+  }
+  // TF goes on whatever lost_odom says: a frame tree that stops would make every consumer's
+  // lookups fail (extrapolation errors) for as long as tracking is lost.
+  const Eigen::Isometry3d base_pose = conjugate(base_from_camera, pose.pose);
+  if (settings_.publish_tf && settings_.guess_frame_id.empty()) {
+    tf_broadcaster_->sendTransform(
+        toTransformMsg(base_pose, settings_.odom_frame_id, base, header.stamp));
+  } else if (settings_.publish_tf && tf.guess_from_base) {
+    // odom -> guess -> base: the correction of the guess frame, so that the chain gives the
+    // estimate and the base keeps its one parent (the wheel odometry's frame). While lost the
+    // estimate follows the guess, so the correction stays as it was and the base goes on
+    // with the wheels.
+    tf_broadcaster_->sendTransform(toTransformMsg(base_pose * tf.guess_from_base->inverse(),
+                                                  settings_.odom_frame_id,
+                                                  settings_.guess_frame_id, header.stamp));
   }
   std_msgs::Header cloud_header = header;
   if (settings_.base_is_optical_frame) cloud_header.frame_id = base;  // the estimated camera
@@ -520,6 +588,7 @@ void OdometryNodelet::publishInfo(const acvo::OdometryResult& r, const std_msgs:
 
 void OdometryNodelet::restart(const Eigen::Isometry3d& camera_pose) {
   odometry_->reset(camera_pose);
+  continuous_.reset();
   published_keyframe_.reset();
 }
 
@@ -666,6 +735,9 @@ void OdometryNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat
   stat.add("last message", last_.message);
   stat.add("last ms total", last_.ms_total);
   stat.add("last ms latency", last_.ms_latency);
+  std::string problems;
+  for (const std::string& p : parameter_problems_) problems += (problems.empty() ? "" : "; ") + p;
+  stat.add("parameter problems", problems.empty() ? std::string("none") : problems);
   stat.add("messages received (rgb, depth, info)", std::to_string(count_.rgb.load()) + ", " +
                                                        std::to_string(count_.depth.load()) + ", " +
                                                        std::to_string(count_.info.load()));

@@ -58,15 +58,59 @@ std::vector<std::string> applyRosParams(const XmlRpc::XmlRpcValue& private_ns,
                                         acvo::Params& params) {
   std::vector<std::string> problems;
   if (private_ns.getType() != XmlRpcValue::TypeStruct) return problems;
+  // The keys the user set, each with its value. A value of the wrong type is reported and
+  // dropped here; the others are applied one at a time below.
   std::set<std::string> known;
-  visitParams(params, [&](const std::string& section, const std::string& name, auto& field) {
+  std::vector<std::pair<std::string, std::string>> given;  // (section, name)
+  acvo::Params typed = params;
+  visitParams(typed, [&](const std::string& section, const std::string& name, auto& field) {
     known.insert(section + "/" + name);
     if (!private_ns.hasMember(section)) return;
     const XmlRpcValue& values = private_ns[section];
     if (values.getType() != XmlRpcValue::TypeStruct || !values.hasMember(name)) return;
     std::string problem = set(section + "/" + name, values[name], field);
-    if (!problem.empty()) problems.push_back(problem);
+    if (problem.empty()) {
+      given.emplace_back(section, name);
+    } else {
+      problems.push_back(problem);
+    }
   });
+  // Each given value alone on top of what is accepted so far; one that makes the set invalid
+  // (a range, or an order with another parameter) is tried again after the others, in case a
+  // partner it needs comes later (ell_min raised with ell_init), and otherwise rejected by
+  // itself: every other value the user gave is kept.
+  const auto with = [&](acvo::Params base, const std::pair<std::string, std::string>& key) {
+    visitParams(base, [&](const std::string& section, const std::string& name, auto& field) {
+      if (section != key.first || name != key.second) return;
+      visitParams(typed, [&](const std::string& s2, const std::string& n2, const auto& value) {
+        if constexpr (std::is_same_v<std::decay_t<decltype(value)>,
+                                     std::decay_t<decltype(field)>>) {
+          if (s2 == key.first && n2 == key.second) field = value;
+        }
+      });
+    });
+    return base;
+  };
+  acvo::Params accepted = params;
+  for (bool progress = true; progress && !given.empty();) {
+    progress = false;
+    for (auto it = given.begin(); it != given.end();) {
+      const acvo::Params trial = with(accepted, *it);
+      if (acvo::validate(trial).empty()) {
+        accepted = trial;
+        it = given.erase(it);
+        progress = true;
+      } else {
+        ++it;
+      }
+    }
+  }
+  for (const auto& key : given) {
+    problems.push_back("~" + key.first + "/" + key.second + " rejected (" +
+                       acvo::validate(with(accepted, key)) +
+                       "); it keeps its default, the other parameters are used");
+  }
+  params = accepted;
   if (private_ns.hasMember("solver")) {
     problems.push_back("~solver was split (ignored): ~registration/engine chooses the engine, "
                        "~coarse_to_fine and ~paper hold each engine's parameters "
@@ -80,9 +124,10 @@ std::vector<std::string> applyRosParams(const XmlRpc::XmlRpcValue& private_ns,
       continue;
     }
     for (const auto& kv : values) {
-      if (!known.count(std::string(section) + "/" + kv.first)) {
-        problems.push_back(std::string("unknown parameter ~") + section + "/" + kv.first +
-                           " (ignored)");
+      const std::string key = std::string(section) + "/" + kv.first;
+      if (!known.count(key)) {
+        problems.push_back("unknown parameter ~" + key + " (ignored)" +
+                           closeMatchHint(key, {known.begin(), known.end()}));
       }
     }
   }

@@ -161,6 +161,48 @@ TEST(CameraFor, UsesCameraInfoAndChecksIt) {
             std::string::npos);
 }
 
+// A rectified stream of a distorted camera: K describes the raw image, P the rectified one the
+// node receives. Binned and ROI streams: P scaled and shifted (image_geometry's reading).
+TEST(CameraFor, UsesTheProjectionMatrixWithBinningAndRegionOfInterest) {
+  sensor_msgs::CameraInfo full = info(520, 525, 330, 250, 640, 480);  // the raw image's K
+  full.distortion_model = "plumb_bob";
+  full.D = {0.1, -0.2, 0.0, 0.0, 0.05};
+  full.R = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  full.P = {500, 0, 320, 0, 0, 505, 240, 0, 0, 0, 1, 0};
+  const CameraResult rectified = cameraFor(full, 640, 480, {});
+  ASSERT_EQ(rectified.problem, "");
+  EXPECT_DOUBLE_EQ(rectified.camera.fx, 500);
+  EXPECT_DOUBLE_EQ(rectified.camera.fy, 505);
+  EXPECT_DOUBLE_EQ(rectified.camera.cx, 320);
+  EXPECT_DOUBLE_EQ(rectified.camera.cy, 240);
+
+  sensor_msgs::CameraInfo binned = full;
+  binned.binning_x = binned.binning_y = 2;
+  const CameraResult half = cameraFor(binned, 320, 240, {});
+  ASSERT_EQ(half.problem, "");
+  EXPECT_DOUBLE_EQ(half.camera.fx, 250);
+  EXPECT_DOUBLE_EQ(half.camera.fy, 252.5);
+  EXPECT_DOUBLE_EQ(half.camera.cx, 160);
+  EXPECT_DOUBLE_EQ(half.camera.cy, 120);
+  EXPECT_NE(cameraFor(binned, 640, 480, {}).problem.find("320x240 after binning"),
+            std::string::npos);
+
+  sensor_msgs::CameraInfo roi = info(500, 505, 320, 240, 640, 480);  // undistorted: K = P
+  roi.distortion_model = "plumb_bob";
+  roi.D.assign(5, 0.0);
+  roi.R = full.R;
+  roi.P = full.P;
+  roi.roi.x_offset = 100;
+  roi.roi.y_offset = 50;
+  roi.roi.width = 200;
+  roi.roi.height = 100;
+  const CameraResult part = cameraFor(roi, 200, 100, {});
+  ASSERT_EQ(part.problem, "");
+  EXPECT_DOUBLE_EQ(part.camera.fx, 500);
+  EXPECT_DOUBLE_EQ(part.camera.cx, 220);
+  EXPECT_DOUBLE_EQ(part.camera.cy, 190);
+}
+
 TEST(CameraFor, OverridesWinOverCameraInfo) {
   const sensor_msgs::CameraInfo zero = info(0, 0, 0, 0, 0, 0);  // ignored when overridden
   IntrinsicsOverride named;
@@ -334,6 +376,47 @@ TEST(StampCheck, DropsRepeatsRestartsOnJumpBackWarnsOnGaps) {
   EXPECT_EQ(checkStamp(100.0, 98.0, 1.0), StampVerdict::kRestart);
   EXPECT_EQ(checkStamp(100.0, 101.5, 1.0), StampVerdict::kGap);
   EXPECT_EQ(checkStamp(100.0, 101.5, 2.0), StampVerdict::kAccept);
+}
+
+// A bag of 0.5 s looped at 10 Hz: its stamps go back by 0.4 s at each loop. Before, every
+// frame of the second loop was dropped (behind the last processed one, by less than the 1 s
+// that marks a restart), and so was every later loop: the node stalled for ever.
+TEST(StampGuard, AShortLoopedBagRestartsInsteadOfStalling) {
+  StampGuard guard;
+  const auto feed = [&](double stamp) {
+    const StampVerdict v = guard.check(stamp, 1.0, 1.0);
+    if (v != StampVerdict::kDrop) guard.processed(stamp);
+    return v;
+  };
+  for (double t : {100.0, 100.1, 100.2, 100.3, 100.4}) EXPECT_EQ(feed(t), StampVerdict::kAccept);
+  EXPECT_EQ(feed(100.0), StampVerdict::kDrop) << "one frame behind: out of order, perhaps";
+  EXPECT_EQ(feed(100.1), StampVerdict::kRestart) << "a second one, later: the bag looped";
+  EXPECT_EQ(feed(100.2), StampVerdict::kAccept);
+  EXPECT_EQ(guard.last(), 100.2);
+}
+
+TEST(StampGuard, OneFrameOutOfOrderOrRepeatedIsDroppedAndTheStreamGoesOn) {
+  StampGuard guard;
+  const auto feed = [&](double stamp) {
+    const StampVerdict v = guard.check(stamp, 1.0, 1.0);
+    if (v != StampVerdict::kDrop) guard.processed(stamp);
+    return v;
+  };
+  EXPECT_EQ(feed(100.0), StampVerdict::kAccept);
+  EXPECT_EQ(feed(100.2), StampVerdict::kAccept);
+  EXPECT_EQ(feed(100.1), StampVerdict::kDrop);
+  EXPECT_EQ(feed(100.3), StampVerdict::kAccept);
+  // The same stamp over and over is never a restart.
+  EXPECT_EQ(feed(100.3), StampVerdict::kDrop);
+  EXPECT_EQ(feed(100.3), StampVerdict::kDrop);
+  EXPECT_EQ(feed(100.3), StampVerdict::kDrop);
+  // Two frames behind, the second earlier than the first: still out of order.
+  EXPECT_EQ(feed(100.25), StampVerdict::kDrop);
+  EXPECT_EQ(feed(100.22), StampVerdict::kDrop);
+  EXPECT_EQ(feed(100.4), StampVerdict::kAccept);
+  EXPECT_EQ(feed(97.0), StampVerdict::kRestart) << "more than 1 s back at once";
+  guard.clear();
+  EXPECT_EQ(guard.check(50.0, 1.0, 1.0), StampVerdict::kAccept);
 }
 
 TEST(CauseThrottle, OneSlotPerCauseSoAFrequentCauseHidesNoOther) {

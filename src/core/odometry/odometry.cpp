@@ -2,6 +2,7 @@
 // keyframe, the pose and its covariance, the tracking judgement and the keyframe choice.
 #include "acvo/odometry.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <sstream>
@@ -13,7 +14,10 @@
 namespace acvo {
 
 struct Odometry::Arena {
-  explicit Arena(int threads) : arena(threads > 0 ? threads : tbb::task_arena::automatic) {}
+  explicit Arena(int threads)
+      : arena(threads > 0    ? threads
+              : threads == 0 ? int(tbb::task_arena::automatic)
+                             : std::max(1, tbb::this_task_arena::max_concurrency() - 1)) {}
   tbb::task_arena arena;
 };
 
@@ -91,6 +95,12 @@ Judgement judgeTracking(const SolverResult& s, const Eigen::Isometry3d& frame_mo
   if (s.status == SolverStatus::kMaxIterations) return {Tracking::kHard, "iteration cap reached"};
   if (!s.hard.empty()) return {Tracking::kHard, s.hard};
   return {Tracking::kOk, ""};
+}
+
+Matrix6d frameMotionCovariance(const Eigen::Isometry3d& last, const Matrix6d& last_cov,
+                               const Matrix6d& current_cov) {
+  const Matrix6d ad = adjointSE3(last.inverse());
+  return ad * (current_cov + last_cov) * ad.transpose();
 }
 
 Eigen::Isometry3d motionPrior(const Eigen::Isometry3d& last, double measured, double interval) {
@@ -201,7 +211,6 @@ OdometryResult Odometry::process(const Frame& frame,
   if (std::string why = frame.problem(); !why.empty()) {
     r.tracking = Tracking::kBadFrame;
     r.message = why;
-    r.motion_covariance = lostCovariance();
     return r;
   }
   const std::shared_ptr<PreparedCloud> current = buildCloud(frame, r);
@@ -291,9 +300,13 @@ void Odometry::tracked(OdometryResult& r, const Registration& reg,
                        const std::shared_ptr<PreparedCloud>& current) {
   const Tracked& keyframe = *keyframe_;
   const Eigen::Isometry3d& to_keyframe = reg.solver.transform;
-  r.motion =
-      last_->index == keyframe.index ? to_keyframe : last_->to_keyframe.inverse() * to_keyframe;
-  r.motion_covariance = reg.covariance;
+  const bool last_is_keyframe = last_->index == keyframe.index;
+  r.motion = last_is_keyframe ? to_keyframe : last_->to_keyframe.inverse() * to_keyframe;
+  r.registration_covariance = reg.covariance;
+  r.motion_covariance =
+      last_is_keyframe ? reg.covariance
+                       : frameMotionCovariance(last_->to_keyframe,
+                                               last_->to_keyframe_covariance, reg.covariance);
   pose_ = normalized(keyframe.pose * to_keyframe);
   pose_covariance_ = keyframe.covariance + rotateCovariance(reg.covariance, keyframe.pose.linear());
   r.pose = pose_;
@@ -302,10 +315,11 @@ void Odometry::tracked(OdometryResult& r, const Registration& reg,
   velocity_interval_ = r.interval;
   lost_in_a_row_ = 0;
 
-  Tracked frame{current, r.frame_index, pose_, pose_covariance_, to_keyframe};
+  Tracked frame{current, r.frame_index, pose_, pose_covariance_, to_keyframe, reg.covariance};
   if (params_.odometry.reference == Reference::kPreviousFrame ||
       takesKeyframe(reg.judgement, reg.solver, params_.odometry)) {
     frame.to_keyframe = Eigen::Isometry3d::Identity();
+    frame.to_keyframe_covariance = Matrix6d::Zero();
     asReference(r, *current);
     keyframe_ = frame;
     r.new_keyframe = true;
@@ -319,7 +333,6 @@ void Odometry::lost(OdometryResult& r, const Registration& reg,
   velocity_ = Eigen::Isometry3d::Identity();
   velocity_interval_ = 0.0;
   r.motion = Eigen::Isometry3d::Identity();
-  r.motion_covariance = lostCovariance();
   ++lost_in_a_row_;
   r.pose = pose_;
   r.pose_covariance =

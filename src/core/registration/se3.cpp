@@ -33,6 +33,14 @@ Eigen::Matrix3d hat(const Eigen::Vector3d& w) {
   return W;
 }
 
+Matrix6d adjointSE3(const Eigen::Isometry3d& T) {
+  Matrix6d ad = Matrix6d::Zero();
+  ad.topLeftCorner<3, 3>() = T.linear();
+  ad.bottomRightCorner<3, 3>() = T.linear();
+  ad.bottomLeftCorner<3, 3>() = hat(T.translation()) * T.linear();
+  return ad;
+}
+
 Eigen::Matrix3d expSO3(const Eigen::Vector3d& w) {
   const auto k = coefficients(w.norm());
   const Eigen::Matrix3d W = hat(w);
