@@ -123,7 +123,7 @@ std::size_t editDistance(const std::string& a, const std::string& b) {
 }  // namespace
 
 std::string closeMatchHint(const std::string& name, const std::vector<std::string>& known) {
-  const std::size_t allowed = std::max<std::size_t>(2, name.size() / 4);
+  const std::size_t allowed = std::max<std::size_t>(2, name.size() / 3);
   std::size_t best = allowed + 1;
   std::string match;
   for (const std::string& k : known) {

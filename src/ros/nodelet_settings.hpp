@@ -72,7 +72,7 @@ std::vector<std::string> unknownParameters(const XmlRpc::XmlRpcValue& private_ns
                                            const std::vector<std::string>& also_known);
 
 // " (did you mean ~x?)" naming the entry of `known` closest to `name` in edit distance, when one
-// is close (at most a quarter of the name's letters, and at least 2, apart); "" otherwise.
+// is close (at most a third of the name's letters, and at least 2, apart); "" otherwise.
 std::string closeMatchHint(const std::string& name, const std::vector<std::string>& known);
 
 // "x y z roll pitch yaw" -> pose; nullopt (and a sentence in *problem) when it is not six

@@ -233,9 +233,9 @@ void OdometryNodelet::loadSettings() {
     parameter_problems_.push_back(problem);
   }
 
+  // odometry/threads: acvo.launch passes -1 (every core but one: the nodelet shares its
+  // manager with the camera driver); without it, the config's or the core's default.
   acvo::Params params;
-  // The nodelet shares its manager with the camera driver: leave it a core unless told.
-  params.odometry.threads = -1;
   // Each value is checked by itself: a bad one is rejected with its reason, the rest are kept.
   for (const std::string& problem : applyRosParams(private_ns, params)) {
     NODELET_ERROR("parameter problem: %s", problem.c_str());

@@ -483,6 +483,65 @@ TEST(RosParams, ReadsEverySectionWithCoreNamesAndReportsProblems) {
   EXPECT_NE(all.find("~solver was split"), std::string::npos) << all;
 }
 
+// Before, one value that acvo::validate rejected put every parameter back to its default.
+TEST(RosParams, ABadValueIsRejectedAloneAndAPairIsAcceptedInAnyOrder) {
+  XmlRpc::XmlRpcValue ns;
+  ns["selection"] = section("target_points", 900);
+  ns["selection"]["min_depth"] = 7.0;  // above max_depth: rejected alone
+  // ell_min above the default ell_init (0.04) is valid only with the raised ell_init: visited
+  // first, it is accepted once ell_init is in.
+  ns["coarse_to_fine"] = section("ell_min", 0.05);
+  ns["coarse_to_fine"]["ell_init"] = 0.08;
+  ns["coarse_to_fine"]["depth_noise"] = -1.0;  // negative: rejected alone
+  acvo::Params p;
+  const std::vector<std::string> problems = applyRosParams(ns, p);
+  EXPECT_EQ(acvo::validate(p), "");
+  EXPECT_EQ(p.selection.target_points, 900);
+  EXPECT_DOUBLE_EQ(p.selection.min_depth, acvo::Params().selection.min_depth);
+  EXPECT_DOUBLE_EQ(p.coarse_to_fine.ell_min, 0.05);
+  EXPECT_DOUBLE_EQ(p.coarse_to_fine.ell_init, 0.08);
+  EXPECT_DOUBLE_EQ(p.coarse_to_fine.depth_noise, acvo::Params().coarse_to_fine.depth_noise);
+  ASSERT_EQ(problems.size(), 2u);
+  EXPECT_NE(problems[0].find("~selection/min_depth rejected (selection.min_depth must be below "
+                             "max_depth)"),
+            std::string::npos)
+      << problems[0];
+  EXPECT_NE(problems[1].find("~coarse_to_fine/depth_noise rejected"), std::string::npos)
+      << problems[1];
+}
+
+TEST(RosParams, UnknownNamesAreReportedWithTheNameTheyHaveHere) {
+  XmlRpc::XmlRpcValue ns;
+  ns["frame_id"] = std::string("base_footprint");
+  ns["wait_for_transform"] = 0.5;
+  ns["odom_frame"] = std::string("odom");
+  ns["rgb"] = section("image_transport", std::string("compressed"));
+  ns["Odom"] = section("Strategy", 0);
+  ns["completely_unrelated_thing"] = 1;
+  ns["base_frame_id"] = std::string("base_link");  // known
+  ns["target_points"] = 1500;                       // dynamic_reconfigure's, known
+  ns["selection"] = section("target_pionts", 1500);
+  const std::vector<std::string> top = unknownParameters(ns, {"target_points"});
+  std::string all;
+  for (const auto& s : top) all += s + "\n";
+  ASSERT_EQ(top.size(), 6u) << all;
+  EXPECT_NE(all.find("~frame_id (ignored): this node calls it ~base_frame_id"), std::string::npos)
+      << all;
+  EXPECT_NE(all.find("this node calls it ~wait_for_transform_duration"), std::string::npos) << all;
+  EXPECT_NE(all.find("~odom_frame (ignored) (did you mean ~odom_frame_id?)"), std::string::npos)
+      << all;
+  EXPECT_NE(all.find("~rgb/image_transport (ignored): this node calls it ~image_transport"),
+            std::string::npos)
+      << all;
+  EXPECT_NE(all.find("~Odom/Strategy (ignored): rtabmap's"), std::string::npos) << all;
+  EXPECT_NE(all.find("~completely_unrelated_thing (ignored)\n"), std::string::npos) << all;
+  acvo::Params p;
+  const std::vector<std::string> in_section = applyRosParams(ns, p);
+  ASSERT_EQ(in_section.size(), 1u);
+  EXPECT_NE(in_section[0].find("(did you mean ~selection/target_points?)"), std::string::npos)
+      << in_section[0];
+}
+
 TEST(RosParams, ReconfigureRoundTripsAndDescribesEveryParameter) {
   acvo::Params p;
   p.selection.target_points = 777;

@@ -306,7 +306,7 @@ TEST(Params, ValidateCatchesInconsistentValues) {
             std::string::npos);
   EXPECT_NE(message([](Params& p) { p.paper.max_step = 0.1; }).find("min_step"),
             std::string::npos);
-  EXPECT_NE(message([](Params& p) { p.odometry.threads = -1; }).find("threads"), std::string::npos);
+  EXPECT_NE(message([](Params& p) { p.odometry.threads = -2; }).find("threads"), std::string::npos);
   EXPECT_NE(message([](Params& p) { p.odometry.keyframe_matched_fraction = 1.5; })
                 .find("odometry.keyframe_matched_fraction"),
             std::string::npos);
