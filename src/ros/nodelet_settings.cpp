@@ -92,7 +92,9 @@ const char* const kTopLevelKeys[] = {
     "publish_null_when_lost", "camera", "fx", "fy", "cx", "cy", "initial_pose",
     // the parameter sections (ros_params.hpp), the old one it reports, the transport hints
     "selection", "registration", "coarse_to_fine", "paper", "odometry", "solver",
-    "image_transport", "depth_image_transport"};
+    "image_transport", "depth_image_transport",
+    // diagnostic_updater's own (it reads it from the same private namespace)
+    "diagnostic_period"};
 
 // Other nodes' names for a setting, and what it is here.
 const std::pair<const char*, const char*> kAliases[] = {
