@@ -22,14 +22,20 @@ import yaml
 
 FRAMES = 30
 # Worst error of the pose relative to the first frame over the synthetic sequence (30 frames
-# at 30 Hz, 0.3 m/s, Kinect-like noise). Measured over engine revisions: 0.020-0.031 m,
-# 0.013-0.016 rad, for the nodelet and acvo_tum alike. The bounds are loose (3x): the
-# comparison with acvo_tum below is the tight check.
-TRANSLATION_TOLERANCE = 0.1  # m
-ROTATION_TOLERANCE = 0.05  # rad
-# The nodelet against acvo_tum on the same frames (measured: 6e-16 m, 3e-8 rad).
-SAME_TRANSLATION = 1e-3  # m
-SAME_ROTATION = 1e-3  # rad
+# at 30 Hz, 0.3 m/s, Kinect-like noise, 320x240): measured 0.0072 m, 0.0042 rad on 2026-11-25
+# with `rostest --text acvo tum_bag.test` (the [ MEASURED ] lines). The bounds are 2.8x and 2.9x
+# that.
+TRANSLATION_TOLERANCE = 0.02  # m
+ROTATION_TOLERANCE = 0.012  # rad
+# The nodelet against acvo_tum on the same frames: measured 5.5e-16 m, 3.0e-8 rad (synthetic)
+# and 4.5e-16 m, 3.0e-8 rad (kitchen7s_dev) on 2026-11-25 with the same command. The odometry
+# gives the same result whatever the number of threads (registration/kernel.hpp), so both runs
+# compute the same poses and what is left is the rounding of the recorded trajectories: a few
+# units in the last place, and for the rotation arccos's resolution next to 0 (3.0e-8 rad is
+# arccos(1 - 4 * 2^-53): four units in the last place below 1). The bounds are 2.7x and 3x the
+# larger.
+SAME_TRANSLATION = 1.5e-15  # m
+SAME_ROTATION = 9e-8  # rad
 SHARED_KITCHEN = os.path.join(os.path.dirname(os.path.realpath(__file__)), "..", "..", "..",
                               "shared", "data", "kitchen7s_dev")
 # CI sets ACVO_REQUIRE_SHARED_DATA=1: there a missing ../shared/data is a failure, not a skip.
