@@ -21,7 +21,8 @@ enum class Reference { kKeyframe, kPreviousFrame };
 struct SelectionParams {
   int target_points = 4000;    // semi-dense cloud size the selector aims at (paper: 3000)
   double min_depth = 0.1;      // m; points outside [min_depth, max_depth] are dropped
-  double max_depth = 4.0;      // m (paper: no limit; Kinect depth beyond 4 m is too coarse here)
+  double max_depth = 10.0;     // m (paper: no limit): far points pin the rotation; their coarse
+                               // depth is modelled along the ray (depth_noise)
   bool canny_fallback = true;  // add Canny edge pixels when fewer than target/3 were selected
 };
 

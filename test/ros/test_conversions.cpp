@@ -487,7 +487,7 @@ TEST(RosParams, ReadsEverySectionWithCoreNamesAndReportsProblems) {
 TEST(RosParams, ABadValueIsRejectedAloneAndAPairIsAcceptedInAnyOrder) {
   XmlRpc::XmlRpcValue ns;
   ns["selection"] = section("target_points", 900);
-  ns["selection"]["min_depth"] = 7.0;  // above max_depth: rejected alone
+  ns["selection"]["min_depth"] = 12.0;  // above max_depth: rejected alone
   // ell_min above the default ell_init (0.04) is valid only with the raised ell_init: visited
   // first, it is accepted once ell_init is in.
   ns["coarse_to_fine"] = section("ell_min", 0.05);

@@ -296,9 +296,9 @@ TEST(Params, ValidateCatchesInconsistentValues) {
             std::string::npos);
   EXPECT_NE(message([](Params& p) { p.selection.target_points = -5; }).find("target_points"),
             std::string::npos);
-  EXPECT_NE(message([](Params& p) { p.selection.min_depth = 6.0; }).find("min_depth"),
+  EXPECT_NE(message([](Params& p) { p.selection.min_depth = 16.0; }).find("min_depth"),
             std::string::npos);
-  EXPECT_NE(message([](Params& p) { p.selection.min_depth = 7.0; }).find("min_depth"),
+  EXPECT_NE(message([](Params& p) { p.selection.min_depth = 17.0; }).find("min_depth"),
             std::string::npos);
   EXPECT_NE(message([](Params& p) {
               p.paper.ell_init = std::numeric_limits<double>::quiet_NaN();
