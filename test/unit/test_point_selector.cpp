@@ -101,7 +101,9 @@ TEST(PointSelector, BorderIsNeverSelected) {
 
 TEST(PointSelector, InvalidDepthIsDroppedAfterSelection) {
   const cv::Mat gray = texturedImage(640, 480, 5);
-  SelectionParams params;  // depth range [0.1, 6]
+  SelectionParams params;
+  params.min_depth = 0.1;  // the range this test is written for, whatever the defaults
+  params.max_depth = 6.0;
   cv::Mat depth = constantDepth(gray.size(), 2.f);
   depth.colRange(0, 128).setTo(0.f);
   depth.colRange(128, 256).setTo(std::numeric_limits<float>::quiet_NaN());
