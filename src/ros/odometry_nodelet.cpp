@@ -115,9 +115,9 @@ class OdometryNodelet : public nodelet::Nodelet {
 
   // Set in onInit; lost_odom also by dynamic_reconfigure.
   NodeletSettings settings_;
-  // What loading the parameters found wrong: logged once, and kept in diagnostics for whoever
-  // looks later.
-  std::vector<std::string> parameter_problems_;
+  // What loading the parameters found wrong ("; "-separated): logged once, and kept in
+  // diagnostics for whoever looks later.
+  std::string parameter_problems_;
   InputTopics topics_;
 
   ros::NodeHandle nh_, pnh_;
@@ -218,29 +218,31 @@ void OdometryNodelet::onInit() {
 void OdometryNodelet::loadSettings() {
   XmlRpc::XmlRpcValue private_ns;
   ros::param::get(pnh_.getNamespace(), private_ns);
-  for (const std::string& problem : loadNodeletSettings(private_ns, settings_)) {
-    NODELET_ERROR("parameter problem: %s", problem.c_str());
-    parameter_problems_.push_back(problem);
-  }
+  // Each problem is logged once and kept for diagnostics.
+  const auto report = [this](const std::vector<std::string>& problems, bool error) {
+    for (const std::string& problem : problems) {
+      if (error) {
+        NODELET_ERROR("parameter problem: %s", problem.c_str());
+      } else {
+        NODELET_WARN("%s", problem.c_str());
+      }
+      parameter_problems_ += (parameter_problems_.empty() ? "" : "; ") + problem;
+    }
+  };
+  report(loadNodeletSettings(private_ns, settings_), true);
   NODELET_INFO("nodelet settings: %s", describe(settings_).c_str());
   pending_base_pose_ = settings_.initial_pose;
   std::vector<std::string> reconfigurable;
   for (const auto& d : acvo::AcvoConfig::__getParamDescriptions__()) {
     reconfigurable.push_back(d->name);
   }
-  for (const std::string& problem : unknownParameters(private_ns, reconfigurable)) {
-    NODELET_WARN("%s", problem.c_str());
-    parameter_problems_.push_back(problem);
-  }
+  report(unknownParameters(private_ns, reconfigurable), false);
 
   // odometry/threads: acvo.launch passes -1 (every core but one: the nodelet shares its
   // manager with the camera driver); without it, the config's or the core's default.
   acvo::Params params;
   // Each value is checked by itself: a bad one is rejected with its reason, the rest are kept.
-  for (const std::string& problem : applyRosParams(private_ns, params)) {
-    NODELET_ERROR("parameter problem: %s", problem.c_str());
-    parameter_problems_.push_back(problem);
-  }
+  report(applyRosParams(private_ns, params), true);
   if (const std::string invalid = acvo::validate(params); !invalid.empty()) {
     NODELET_ERROR("invalid parameters (%s): using the defaults of acvo::Params instead",
                   invalid.c_str());
@@ -735,9 +737,8 @@ void OdometryNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat
   stat.add("last message", last_.message);
   stat.add("last ms total", last_.ms_total);
   stat.add("last ms latency", last_.ms_latency);
-  std::string problems;
-  for (const std::string& p : parameter_problems_) problems += (problems.empty() ? "" : "; ") + p;
-  stat.add("parameter problems", problems.empty() ? std::string("none") : problems);
+  stat.add("parameter problems",
+           parameter_problems_.empty() ? std::string("none") : parameter_problems_);
   stat.add("messages received (rgb, depth, info)", std::to_string(count_.rgb.load()) + ", " +
                                                        std::to_string(count_.depth.load()) + ", " +
                                                        std::to_string(count_.info.load()));

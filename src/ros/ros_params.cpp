@@ -58,12 +58,12 @@ std::vector<std::string> applyRosParams(const XmlRpc::XmlRpcValue& private_ns,
                                         acvo::Params& params) {
   std::vector<std::string> problems;
   if (private_ns.getType() != XmlRpcValue::TypeStruct) return problems;
-  // The keys the user set, each with its value. A value of the wrong type is reported and
-  // dropped here; the others are applied one at a time below.
+  // The keys the user set. A value of the wrong type is reported and dropped here (on a scratch
+  // copy); the others are applied one at a time below.
   std::set<std::string> known;
   std::vector<std::pair<std::string, std::string>> given;  // (section, name)
-  acvo::Params typed = params;
-  visitParams(typed, [&](const std::string& section, const std::string& name, auto& field) {
+  acvo::Params scratch = params;
+  visitParams(scratch, [&](const std::string& section, const std::string& name, auto& field) {
     known.insert(section + "/" + name);
     if (!private_ns.hasMember(section)) return;
     const XmlRpcValue& values = private_ns[section];
@@ -81,13 +81,9 @@ std::vector<std::string> applyRosParams(const XmlRpc::XmlRpcValue& private_ns,
   // itself: every other value the user gave is kept.
   const auto with = [&](acvo::Params base, const std::pair<std::string, std::string>& key) {
     visitParams(base, [&](const std::string& section, const std::string& name, auto& field) {
-      if (section != key.first || name != key.second) return;
-      visitParams(typed, [&](const std::string& s2, const std::string& n2, const auto& value) {
-        if constexpr (std::is_same_v<std::decay_t<decltype(value)>,
-                                     std::decay_t<decltype(field)>>) {
-          if (s2 == key.first && n2 == key.second) field = value;
-        }
-      });
+      if (section == key.first && name == key.second) {
+        set(section + "/" + name, private_ns[section][name], field);  // its type was checked
+      }
     });
     return base;
   };

@@ -147,13 +147,18 @@ TEST(DecodeDepth, NamesAnUnsupportedEncodingAndForeignByteOrder) {
   EXPECT_NE(decodeDepth(m).problem.find("byte order"), std::string::npos);
 }
 
+// The four intrinsics of a camera, each exactly.
+void expectIntrinsics(const acvo::Camera& c, double fx, double fy, double cx, double cy) {
+  EXPECT_DOUBLE_EQ(c.fx, fx);
+  EXPECT_DOUBLE_EQ(c.fy, fy);
+  EXPECT_DOUBLE_EQ(c.cx, cx);
+  EXPECT_DOUBLE_EQ(c.cy, cy);
+}
+
 TEST(CameraFor, UsesCameraInfoAndChecksIt) {
   const CameraResult ok = cameraFor(info(500, 510, 320, 240, 640, 480), 640, 480, {});
   ASSERT_EQ(ok.problem, "");
-  EXPECT_DOUBLE_EQ(ok.camera.fx, 500);
-  EXPECT_DOUBLE_EQ(ok.camera.fy, 510);
-  EXPECT_DOUBLE_EQ(ok.camera.cx, 320);
-  EXPECT_DOUBLE_EQ(ok.camera.cy, 240);
+  expectIntrinsics(ok.camera, 500, 510, 320, 240);
   EXPECT_TRUE(ok.camera.valid());
   EXPECT_NE(cameraFor(info(0, 510, 320, 240, 640, 480), 640, 480, {}).problem.find("focal"),
             std::string::npos);
@@ -171,19 +176,13 @@ TEST(CameraFor, UsesTheProjectionMatrixWithBinningAndRegionOfInterest) {
   full.P = {500, 0, 320, 0, 0, 505, 240, 0, 0, 0, 1, 0};
   const CameraResult rectified = cameraFor(full, 640, 480, {});
   ASSERT_EQ(rectified.problem, "");
-  EXPECT_DOUBLE_EQ(rectified.camera.fx, 500);
-  EXPECT_DOUBLE_EQ(rectified.camera.fy, 505);
-  EXPECT_DOUBLE_EQ(rectified.camera.cx, 320);
-  EXPECT_DOUBLE_EQ(rectified.camera.cy, 240);
+  expectIntrinsics(rectified.camera, 500, 505, 320, 240);
 
   sensor_msgs::CameraInfo binned = full;
   binned.binning_x = binned.binning_y = 2;
   const CameraResult half = cameraFor(binned, 320, 240, {});
   ASSERT_EQ(half.problem, "");
-  EXPECT_DOUBLE_EQ(half.camera.fx, 250);
-  EXPECT_DOUBLE_EQ(half.camera.fy, 252.5);
-  EXPECT_DOUBLE_EQ(half.camera.cx, 160);
-  EXPECT_DOUBLE_EQ(half.camera.cy, 120);
+  expectIntrinsics(half.camera, 250, 252.5, 160, 120);
   EXPECT_NE(cameraFor(binned, 640, 480, {}).problem.find("320x240 after binning"),
             std::string::npos);
 
@@ -198,9 +197,7 @@ TEST(CameraFor, UsesTheProjectionMatrixWithBinningAndRegionOfInterest) {
   roi.roi.height = 100;
   const CameraResult part = cameraFor(roi, 200, 100, {});
   ASSERT_EQ(part.problem, "");
-  EXPECT_DOUBLE_EQ(part.camera.fx, 500);
-  EXPECT_DOUBLE_EQ(part.camera.cx, 220);
-  EXPECT_DOUBLE_EQ(part.camera.cy, 190);
+  expectIntrinsics(part.camera, 500, 505, 220, 190);
 }
 
 TEST(CameraFor, OverridesWinOverCameraInfo) {
