@@ -24,6 +24,11 @@ struct LabelledCloud {
   std::vector<std::array<std::uint8_t, 3>> rgb;   // colour of each point, R G B
   double stamp = 0.0;
   int width = 0, height = 0;  // image size it was built from
+  // The grey and depth images and intrinsics it was built from (the default engine's direct
+  // terms read them; empty for a cloud made of points alone).
+  cv::Mat gray;   // CV_8UC1
+  cv::Mat depth;  // CV_32FC1 metres, 0 or NaN = none
+  Camera camera;
 
   std::size_t size() const { return points.size(); }
   bool empty() const { return points.empty(); }

@@ -57,6 +57,13 @@ struct CoarseToFineParams {
   // Steps that keep their direction and shrink by a ratio rho are extended by 1 / (1 - rho),
   // rho capped at this (extrapolatedStep; 0 = plain Gauss-Newton steps).
   double level_acceleration = 0.5;
+  // The last level's direct terms (docs/method.md §6), added to the kernel's quadratic: each
+  // point's grey value against the reference image where it projects (photometric), and its
+  // distance to the plane of the reference's depth there (point_to_plane; its weight fades to
+  // none as the depth's residuals reach the depth noise above, so it counts where depth is
+  // better than a Kinect's). Off: the kernel alone, as before them.
+  bool photometric = true;
+  bool point_to_plane = true;
   int min_points = 30;  // fewer points in either cloud -> status too_few_points
   // Registration covariance = covariance_scale * (-H)^-1, H the Gauss-Newton information.
   double covariance_scale = 3.0e-7;
@@ -181,6 +188,8 @@ void visitParams(Params_& p, Visitor&& visit) {
   visit("coarse_to_fine", "level_iterations", c.level_iterations);
   visit("coarse_to_fine", "level_eps", c.level_eps);
   visit("coarse_to_fine", "level_acceleration", c.level_acceleration);
+  visit("coarse_to_fine", "photometric", c.photometric);
+  visit("coarse_to_fine", "point_to_plane", c.point_to_plane);
   visit("coarse_to_fine", "min_points", c.min_points);
   visit("coarse_to_fine", "covariance_scale", c.covariance_scale);
   auto& a = p.paper;

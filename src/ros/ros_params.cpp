@@ -160,6 +160,8 @@ acvo::AcvoConfig toConfig(const acvo::Params& params, LostOdom lost_odom) {
   c.color_ell = params.coarse_to_fine.color_ell;
   c.depth_noise = params.coarse_to_fine.depth_noise;
   c.level_iterations = params.coarse_to_fine.level_iterations;
+  c.photometric = params.coarse_to_fine.photometric;
+  c.point_to_plane = params.coarse_to_fine.point_to_plane;
   c.paper_ell_policy = acvo::toString(params.paper.ell_policy);
   c.paper_ell_init = params.paper.ell_init;
   c.paper_ell_min = params.paper.ell_min;
@@ -181,6 +183,8 @@ acvo::Params fromConfig(const acvo::AcvoConfig& config, acvo::Params base) {
   base.coarse_to_fine.color_ell = config.color_ell;
   base.coarse_to_fine.depth_noise = config.depth_noise;
   base.coarse_to_fine.level_iterations = config.level_iterations;
+  base.coarse_to_fine.photometric = config.photometric;
+  base.coarse_to_fine.point_to_plane = config.point_to_plane;
   acvo::fromString(config.paper_ell_policy, base.paper.ell_policy);
   base.paper.ell_init = config.paper_ell_init;
   base.paper.ell_min = config.paper_ell_min;

@@ -546,6 +546,7 @@ TEST(RosParams, ReconfigureRoundTripsAndDescribesEveryParameter) {
   p.paper.ell_policy = acvo::EllPolicy::kFixedSchedule;
   p.paper.color_ell = 0.25;
   p.coarse_to_fine.depth_noise = 0.001;
+  p.coarse_to_fine.point_to_plane = false;
   p.odometry.initial_guess = acvo::InitialGuess::kIdentity;
   const acvo::AcvoConfig c = toConfig(p, LostOdom::kNone);
   EXPECT_EQ(c.lost_odom, "none");

@@ -2,7 +2,8 @@
 // (a Gaussian kept to 3 ell, each point's length-scale in proportion to its depth and stretched
 // along its viewing ray by the depth noise) and maximised level by level, from a wide
 // length-scale on a few points to the finest on all of them, by Gauss-Newton steps on the
-// quadratic that minorises F at the current kernel values.
+// quadratic that minorises F at the current kernel values; at the finest level, photometric
+// and point-to-plane residuals (direct_terms.hpp) add their precision to that quadratic.
 #pragma once
 
 #include <memory>
@@ -12,13 +13,19 @@
 #include "acvo/params.hpp"
 #include "acvo/registration.hpp"
 #include "acvo/registration/kernel.hpp"
+#include "acvo/registration/direct_terms.hpp"
 
 namespace acvo {
 
-// A cloud as this engine prepares it: a reference gets one search grid per level.
+// A cloud as this engine prepares it: its images for the direct terms (when on), and for a
+// reference one search grid per level and the images' gradients.
 struct CoarseToFineCloud : PreparedCloud {
   std::vector<VoxelGrid> level_grids;  // one per levelElls, built by prepareReference
+  DirectImages images;
 };
+
+// Whether the last level adds direct terms to the kernel's.
+bool directTerms(const CoarseToFineParams& p);
 
 // The length-scales of the levels: ell_init, ell_init * ell_reduction, ... down to ell_min
 // (always the last).
@@ -52,6 +59,7 @@ class LevelKernel {
   LevelKernel(const LabelledCloud& fixed, const LabelledCloud& moving, const VoxelGrid& grid,
               const CoarseToFineParams& params);
   const LevelSums& evaluate(const Eigen::Isometry3d& T, double ell);
+  const LevelSums& last() const { return sums_; }  // the last evaluate()'s
   int listBuilds() const { return lists_.builds(); }
 
  private:

@@ -56,6 +56,10 @@ LabelledCloud buildLabelledCloud(const Frame& frame, const SelectionParams& para
   cloud.stamp = frame.stamp;
   cloud.width = frame.color.cols;
   cloud.height = frame.color.rows;
+  // The frame's images are the caller's: the cloud keeps its own copies.
+  cloud.gray = frame.order == ColorOrder::kGray ? gray.clone() : gray;
+  cloud.depth = frame.depth.clone();
+  cloud.camera = frame.camera;
   cloud.pixels = std::move(selection.pixels);
   const std::size_t n = cloud.pixels.size();
   cloud.points.reserve(n);

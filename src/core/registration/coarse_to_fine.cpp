@@ -22,26 +22,73 @@ double msSince(Clock::time_point t0) {
 // Steps this well aligned (cosine) are taken as one linear convergence (extrapolatedStep).
 constexpr double kAlignedSteps = 0.9;
 
-// One Gauss-Newton step on the minorising quadratic of the last evaluate(): the left increment
-// that raises F. Identity when the pairs constrain nothing.
-Eigen::Isometry3d levelStep(const LevelSums& s) {
-  const Eigen::LDLT<Matrix6d> ldlt(s.H);
-  if (ldlt.info() != Eigen::Success || !(s.H.trace() > 0.0)) return Eigen::Isometry3d::Identity();
-  const Vector6d xi = ldlt.solve(s.g);
+// One Gauss-Newton step on a quadratic: the left increment H^-1 g. Identity when it constrains
+// nothing.
+Eigen::Isometry3d levelStep(const Matrix6d& H, const Vector6d& g) {
+  const Eigen::LDLT<Matrix6d> ldlt(H);
+  if (ldlt.info() != Eigen::Success || !(H.trace() > 0.0)) return Eigen::Isometry3d::Identity();
+  const Vector6d xi = ldlt.solve(g);
   return xi.allFinite() ? expSE3(xi) : Eigen::Isometry3d::Identity();
 }
 
+// The direct terms of a level, when it has them.
+struct LevelDirect {
+  const DirectImages* reference = nullptr;
+  const DirectImages* moving = nullptr;
+  const LabelledCloud* moving_cloud = nullptr;
+};
+
+// The step's quadratic: the kernel's, plus the direct terms' where the level has them. Returns
+// the factor that took the kernel's sums to the terms' units.
+double addDirectTerms(const LevelSums& s, double ell, const LevelDirect& direct,
+                      const CoarseToFineParams& p, const Eigen::Isometry3d& T, Matrix6d& H,
+                      Vector6d& g) {
+  // The kernel's quadratic is sum a_ij (x_i - y)^T W (x_i - y) / 2 ell_j^2 but for the factor
+  // ell^2 its sums leave out: divided by ell^2 and by the mean kernel mass of a matched point,
+  // each matched point weighs as one position known to ell_j, the scale the terms below are in.
+  const double mass = s.F / double(std::max<std::int64_t>(s.matched, 1));
+  const double to_units = mass > 0.0 ? 1.0 / (ell * ell * mass) : 0.0;
+  if (!(to_units > 0.0)) return 0.0;
+  H = s.H * to_units;
+  g = s.g * to_units;
+  if (p.photometric) {
+    const DirectSums d =
+        photometricSums(*direct.reference, *direct.moving, *direct.moving_cloud, T);
+    H += d.H;
+    g += d.g;
+  }
+  if (p.point_to_plane) {
+    const DirectSums d =
+        pointToPlaneSums(*direct.reference, *direct.moving_cloud, T, p.depth_noise);
+    H += d.H;
+    g += d.g;
+  }
+  return to_units;
+}
+
 // Iterates one level from T; returns false when a step was not finite.
-bool iterateLevel(LevelKernel& kernel, double ell, double eps, bool last,
+bool iterateLevel(LevelKernel& kernel, const LevelDirect& direct, double ell, double eps, bool last,
                   const CoarseToFineParams& p, Eigen::Isometry3d& T, SolverResult& result) {
   Vector6d previous = Vector6d::Zero();
   for (int it = 0; it < p.level_iterations; ++it) {
     const auto t0 = Clock::now();
     const LevelSums& s = kernel.evaluate(T, ell);
+    Matrix6d H = s.H;
+    Vector6d g = s.g;
+    // The information of the registration: the quadratic's, in the kernel's own units (those
+    // covariance_scale was calibrated in).
+    result.hessian = -s.H;
+    if (direct.reference) {
+      const double to_units = addDirectTerms(s, ell, direct, p, T, H, g);
+      if (to_units > 0.0) result.hessian = -H / to_units;
+    }
     result.ms_neighbours += msSince(t0);
-    const Eigen::Isometry3d step = levelStep(s);
+    const Eigen::Isometry3d step = levelStep(H, g);
     if (!step.matrix().allFinite()) return false;
-    const Vector6d xi = extrapolatedStep(logSE3(step), previous, p.level_acceleration);
+    // The direct terms converge as Gauss-Newton does, not as the kernel's slow
+    // minorise-maximise: their steps are taken as they are.
+    const double acceleration = direct.reference ? 0.0 : p.level_acceleration;
+    const Vector6d xi = extrapolatedStep(logSE3(step), previous, acceleration);
     T = normalized(expSE3(xi) * T);
     previous = xi;
     result.trace.push_back({ell, ell, 1.0, xi.norm(), s.F, s.nnz});
@@ -53,6 +100,10 @@ bool iterateLevel(LevelKernel& kernel, double ell, double eps, bool last,
 }
 
 }  // namespace
+
+bool directTerms(const CoarseToFineParams& p) {
+  return p.photometric || p.point_to_plane;
+}
 
 std::vector<double> levelElls(const CoarseToFineParams& p) {
   std::vector<double> ells;
@@ -72,10 +123,13 @@ Vector6d extrapolatedStep(const Vector6d& step, const Vector6d& previous, double
 }
 
 std::shared_ptr<CoarseToFineCloud> prepareCoarseToFine(LabelledCloud cloud,
-                                                      const CoarseToFineParams& p,
-                                                      bool as_reference) {
+                                                       const CoarseToFineParams& p,
+                                                       bool as_reference) {
+  const auto t0 = Clock::now();
   auto out = std::make_shared<CoarseToFineCloud>();
   out->cloud = std::move(cloud);
+  if (directTerms(p)) out->images = directImages(out->cloud);
+  out->ms_prepare = msSince(t0);
   if (as_reference) prepareCoarseToFineReference(*out, p);
   return out;
 }
@@ -84,9 +138,10 @@ double prepareCoarseToFineReference(CoarseToFineCloud& cloud, const CoarseToFine
   if (cloud.reference) return 0.0;
   const auto t0 = Clock::now();
   for (double ell : levelElls(p)) {
-    cloud.level_grids.emplace_back(
-        cloud.cloud.points, gridCell(ell, p.sigma, p.sparsification, maxEllScale(p)));
+    cloud.level_grids.emplace_back(cloud.cloud.points,
+                                   gridCell(ell, p.sigma, p.sparsification, maxEllScale(p)));
   }
+  addGradients(cloud.images);
   cloud.reference = true;
   const double ms = msSince(t0);
   cloud.ms_prepare += ms;
@@ -126,7 +181,11 @@ SolverResult alignCoarseToFine(const CoarseToFineCloud& fixed, const CoarseToFin
     // A level need not resolve the motion finer than its length-scale allows: the next level
     // refines it (measured: a third fewer iterations, the same accuracy).
     const double eps = p.level_eps * ell / ells.back();
-    if (!iterateLevel(*kernel, ell, eps, last, p, T, result)) {
+    LevelDirect direct;
+    if (last && directTerms(p) && !fixed.images.empty() && !moving.images.empty()) {
+      direct = {&fixed.images, &moving.images, &moving.cloud};
+    }
+    if (!iterateLevel(*kernel, direct, ell, eps, last, p, T, result)) {
       result.status = SolverStatus::kNotFinite;
       result.transform = guess;
       result.ms_total = msSince(t_start);
@@ -138,14 +197,15 @@ SolverResult alignCoarseToFine(const CoarseToFineCloud& fixed, const CoarseToFin
     result.status = SolverStatus::kNotFinite;
     result.transform = guess;
   }
-  // Final figures on the full cloud at the finest length-scale: the last level's kernel.
-  const LevelSums& s = kernel->evaluate(T, ells.back());
+  // Final figures on the full cloud at the finest length-scale: the last level's kernel at its
+  // last iterate, a step short of T (a step under eps when converged; one more kernel pass at T
+  // gave the same trajectories on teddy200).
+  const LevelSums& s = kernel->last();
   result.nnz = std::size_t(s.nnz);
   result.matched_fraction = double(s.matched) / double(std::max<std::size_t>(moving.size(), 1));
   result.objective = s.F;
-  // The information of the minorising quadratic at the optimum (the Gauss-Newton matrix the
-  // steps solve with); the exact curvature of the narrow kernel is no better conditioned.
-  result.hessian = -s.H;
+  // result.hessian: the information of the last iterate's quadratic (the Gauss-Newton matrix
+  // the steps solve with); the exact curvature of the narrow kernel is no better conditioned.
   result.list_builds = kernel->listBuilds();
   result.ms_total = msSince(t_start);
   return result;

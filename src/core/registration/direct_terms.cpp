@@ -1,0 +1,204 @@
+// The last-level terms (docs/method.md §6): photometric and point-to-plane residuals of the
+// moving cloud's points in the reference's images, with their Gauss-Newton sums.
+#include "acvo/registration/direct_terms.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include <opencv2/imgproc.hpp>
+
+namespace acvo {
+namespace {
+
+// Huber's threshold in units of the learned scale.
+constexpr double kHuber = 2.0;
+// Where an intensity edge lies is known to a pixel's quantisation, 1/sqrt(12) px (a sensor
+// integrates over its pixel, a renderer samples its centre): at a sharp edge this, times the
+// gradient, outweighs the grey-level noise (DSO's gradient-dependent weight, with its constant
+// from the pixel grid).
+constexpr double kEdgePosition2 = 1.0 / 12.0;  // px^2
+// The learned scales stop here: a grey level (the 8-bit quantisation); 1e-5 m at 1 m of depth
+// (a 16-bit PNG at 5000 per metre quantises to 2e-4 m).
+constexpr double kMinIntensityScale = 1.0;
+constexpr double kMinPlaneScale = 1e-5;
+// Depths that differ by more than this fraction belong to different surfaces.
+constexpr float kSameSurface = 0.05f;
+
+bool sameSurface(float a, float b) {
+  return a > 0.0f && b > 0.0f && std::abs(a - b) <= kSameSurface * std::min(a, b);
+}
+
+// Whether the depth around pixel p (its 4 neighbours) is one surface with depth z.
+bool smoothAround(const cv::Mat& depth, const cv::Point& p, float z) {
+  if (p.x < 1 || p.y < 1 || p.x + 1 >= depth.cols || p.y + 1 >= depth.rows) return false;
+  return sameSurface(depth.at<float>(p.y, p.x - 1), z) &&
+         sameSurface(depth.at<float>(p.y, p.x + 1), z) &&
+         sameSurface(depth.at<float>(p.y - 1, p.x), z) &&
+         sameSurface(depth.at<float>(p.y + 1, p.x), z);
+}
+
+// Whether the surface goes on straight from step a to step b (within kFold).
+constexpr double kFold = 0.2;  // sine of the largest turn, about 12 deg
+bool straight(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return a.cross(b).norm() <= kFold * a.norm() * b.norm();
+}
+
+// Bilinear sample of a CV_32FC1 image at (u, v) in [0, cols - 1) x [0, rows - 1).
+float bilinear(const cv::Mat& image, double u, double v) {
+  const int x = int(u), y = int(v);
+  const float a = float(u - x), b = float(v - y);
+  const float* r0 = image.ptr<float>(y) + x;
+  const float* r1 = image.ptr<float>(y + 1) + x;
+  return (1.0f - b) * ((1.0f - a) * r0[0] + a * r0[1]) + b * ((1.0f - a) * r1[0] + a * r1[1]);
+}
+
+// Where a moving point lands in the reference: its position y there and pixel (u, v), when it
+// lands inside the image (one pixel in, for the derivatives and the bilinear sample), in front
+// of the camera, on the surface the reference's depth shows there, and comes from a point of
+// one surface in its own image.
+struct Landing {
+  Eigen::Vector3d y;
+  double u = 0.0, v = 0.0;
+};
+bool land(const DirectImages& reference, const LabelledCloud& moving, std::size_t j,
+          const Eigen::Isometry3d& T, Landing& out) {
+  const Camera& cam = reference.camera;
+  out.y = T * moving.points[j].cast<double>();
+  if (!(out.y.z() > 0.0)) return false;
+  out.u = cam.fx * out.y.x() / out.y.z() + cam.cx;
+  out.v = cam.fy * out.y.y() / out.y.z() + cam.cy;
+  const cv::Mat& D = reference.depth;
+  if (!(out.u >= 1.0 && out.v >= 1.0 && out.u < D.cols - 2.0 && out.v < D.rows - 2.0)) {
+    return false;
+  }
+  return sameSurface(D.at<float>(int(std::lround(out.v)), int(std::lround(out.u))), float(out.y.z())) &&
+         smoothAround(moving.depth, moving.pixels[j], moving.points[j].z());
+}
+
+// One residual, its Jacobian for a left perturbation, and how much it says about the motion
+// (its squared sensitivity to a shift: the squared intensity gradient, or 1).
+struct Residual {
+  double r;
+  Vector6d J;
+  double say = 1.0;
+};
+
+// Learns the scale s of the residuals (at least min_scale): 1.4826 times their median absolute
+// value, each residual counted by its say, so that the many that carry nothing (grey values on
+// a flat colour) do not set the scale of the few that carry the motion. Then sums them, each
+// with the variance s^2 + say * position_var, Huber-weighted beyond 2 of its standard
+// deviations, and the whole times weight(s).
+template <typename Weight>
+DirectSums sumsOf(std::vector<Residual>& residuals, double min_scale, double position_var,
+                  Weight&& weight) {
+  DirectSums s;
+  if (residuals.empty()) return s;
+  std::sort(residuals.begin(), residuals.end(),
+            [](const Residual& a, const Residual& b) { return std::abs(a.r) < std::abs(b.r); });
+  double total = 0.0;
+  for (const Residual& q : residuals) total += q.say;
+  double median = std::abs(residuals.back().r), seen = 0.0;
+  for (const Residual& q : residuals) {
+    seen += q.say;
+    if (seen >= 0.5 * total) {
+      median = std::abs(q.r);
+      break;
+    }
+  }
+  s.scale = std::max(1.4826 * median, min_scale);
+  const double factor = weight(s.scale);
+  if (!(factor > 0.0)) return s;
+  for (const Residual& q : residuals) {
+    const double var = s.scale * s.scale + q.say * position_var;
+    const double w = factor / var * std::min(1.0, kHuber * std::sqrt(var) / std::abs(q.r));
+    s.H.noalias() += w * q.J * q.J.transpose();
+    s.g.noalias() -= (w * q.r) * q.J;
+  }
+  s.used = int(residuals.size());
+  return s;
+}
+
+}  // namespace
+
+DirectImages directImages(const LabelledCloud& cloud) {
+  DirectImages out;
+  if (cloud.gray.empty() || cloud.depth.empty()) return out;
+  cloud.gray.convertTo(out.intensity, CV_32F);
+  cv::GaussianBlur(out.intensity, out.intensity, cv::Size(0, 0), kSmoothing);
+  out.depth = cloud.depth;
+  out.camera = cloud.camera;
+  return out;
+}
+
+void addGradients(DirectImages& images) {
+  if (images.intensity.empty() || !images.gx.empty()) return;
+  // ksize 1: the plain [-1 0 1] difference, halved: central differences.
+  cv::Sobel(images.intensity, images.gx, CV_32F, 1, 0, 1, 0.5);
+  cv::Sobel(images.intensity, images.gy, CV_32F, 0, 1, 1, 0.5);
+}
+
+DirectSums photometricSums(const DirectImages& reference, const DirectImages& moving,
+                           const LabelledCloud& moving_cloud, const Eigen::Isometry3d& T) {
+  if (reference.empty() || reference.gx.empty() || moving.empty() ||
+      moving_cloud.pixels.size() != moving_cloud.size()) {
+    return {};
+  }
+  const Camera& cam = reference.camera;
+  std::vector<Residual> residuals;
+  residuals.reserve(moving_cloud.size());
+  Landing l;
+  for (std::size_t j = 0; j < moving_cloud.size(); ++j) {
+    if (!land(reference, moving_cloud, j, T, l)) continue;
+    const cv::Point& px = moving_cloud.pixels[j];
+    const double r = double(bilinear(reference.intensity, l.u, l.v)) -
+                     double(moving.intensity.at<float>(px.y, px.x));
+    const double gu = bilinear(reference.gx, l.u, l.v), gv = bilinear(reference.gy, l.u, l.v);
+    // d r / d y = [gu gv] d pi / d y; d y / d xi = [-hat(y), I], and (-hat(y))^T d = y x d.
+    const double iz = 1.0 / l.y.z();
+    const Eigen::Vector3d d(gu * cam.fx * iz, gv * cam.fy * iz,
+                            -(gu * cam.fx * l.y.x() + gv * cam.fy * l.y.y()) * iz * iz);
+    Residual q{r, Vector6d(), gu * gu + gv * gv};
+    q.J << l.y.cross(d), d;
+    residuals.push_back(q);
+  }
+  return sumsOf(residuals, kMinIntensityScale, kEdgePosition2, [](double) { return 1.0; });
+}
+
+DirectSums pointToPlaneSums(const DirectImages& reference, const LabelledCloud& moving_cloud,
+                            const Eigen::Isometry3d& T, double depth_noise) {
+  if (reference.empty() || moving_cloud.depth.empty() ||
+      moving_cloud.pixels.size() != moving_cloud.size()) {
+    return {};
+  }
+  const Camera& cam = reference.camera;
+  const cv::Mat& D = reference.depth;
+  auto pointAt = [&](int u, int v) { return cam.backProject(u, v, double(D.at<float>(v, u))); };
+  std::vector<Residual> residuals;
+  residuals.reserve(moving_cloud.size());
+  Landing l;
+  for (std::size_t j = 0; j < moving_cloud.size(); ++j) {
+    if (!land(reference, moving_cloud, j, T, l)) continue;
+    const int u = int(std::lround(l.u)), v = int(std::lround(l.v));
+    if (!smoothAround(D, cv::Point(u, v), D.at<float>(v, u))) continue;
+    const Eigen::Vector3d x = pointAt(u, v);
+    const Eigen::Vector3d left = x - pointAt(u - 1, v), right = pointAt(u + 1, v) - x;
+    const Eigen::Vector3d up = x - pointAt(u, v - 1), down = pointAt(u, v + 1) - x;
+    // A plane only: a fold (a corner of two walls, a box's edge) has no normal.
+    if (!straight(left, right) || !straight(up, down)) continue;
+    const Eigen::Vector3d n = (left + right).cross(up + down).normalized();
+    if (!n.allFinite()) continue;
+    // Depth noise grows with z^2: residuals in metres per metre^2 share one scale.
+    const double inv_z2 = 1.0 / (l.y.z() * l.y.z());
+    Residual q{n.dot(l.y - x) * inv_z2, Vector6d(), 1.0};
+    q.J << inv_z2 * l.y.cross(n), inv_z2 * n;
+    residuals.push_back(q);
+  }
+  // Both points' depth noise, as the kernel assumes it.
+  const double modelled = std::sqrt(2.0) * depth_noise;
+  return sumsOf(residuals, kMinPlaneScale, 0.0, [modelled](double scale) {
+    return modelled > 0.0 ? std::clamp(1.0 - scale / (kPlaneFade * modelled), 0.0, 1.0) : 1.0;
+  });
+}
+
+}  // namespace acvo
