@@ -39,6 +39,17 @@ Pair renderedPair(bool texture, bool noise) {
           buildLabelledCloud(synth::render(scene, pose_a * trueMotion(), ro, 2).toFrame(), sel)};
 }
 
+// Each term at a transform, over the landings of b's points in a, as the engine calls them.
+DirectSums photometricAt(const DirectImages& a, const DirectImages& b, const LabelledCloud& cloud_b,
+                         const Eigen::Isometry3d& T) {
+  return photometricSums(a, b, cloud_b, landings(a, b, cloud_b, T));
+}
+DirectSums pointToPlaneAt(const DirectImages& a, const DirectImages& b,
+                          const LabelledCloud& cloud_b, const Eigen::Isometry3d& T,
+                          double depth_noise) {
+  return pointToPlaneSums(a, landings(a, b, cloud_b, T), depth_noise);
+}
+
 struct Error {
   double mm, deg;
 };
@@ -68,9 +79,9 @@ TEST(DirectTerms, PhotometricAloneConvergesToTheTrueMotion) {
   addGradients(ref);
   const DirectImages mov = directImages(p.b);
   const Error start =
-      errorOf(iterate([&](const auto& T) { return photometricSums(ref, mov, p.b, T); }, 0));
+      errorOf(iterate([&](const auto& T) { return photometricAt(ref, mov, p.b, T); }, 0));
   const Error e =
-      errorOf(iterate([&](const auto& T) { return photometricSums(ref, mov, p.b, T); }, 8));
+      errorOf(iterate([&](const auto& T) { return photometricAt(ref, mov, p.b, T); }, 8));
   std::printf("  photometric: %.3f mm %.4f deg from %.3f mm %.4f deg\n", e.mm, e.deg, start.mm,
               start.deg);
   // Measured 0.046 mm / 0.0013 deg from 3.5 mm / 0.17 deg (the rendered texture is sampled
@@ -81,9 +92,9 @@ TEST(DirectTerms, PhotometricAloneConvergesToTheTrueMotion) {
 
 TEST(DirectTerms, PointToPlaneAloneConvergesOnExactDepth) {
   const Pair p = renderedPair(false, false);
-  const DirectImages ref = directImages(p.a);
+  const DirectImages ref = directImages(p.a), mov = directImages(p.b);
   const Error e =
-      errorOf(iterate([&](const auto& T) { return pointToPlaneSums(ref, p.b, T, 0.0025); }, 8));
+      errorOf(iterate([&](const auto& T) { return pointToPlaneAt(ref, mov, p.b, T, 0.0025); }, 8));
   std::printf("  point to plane: %.4f mm %.5f deg\n", e.mm, e.deg);
   // Measured 0.026 mm / 0.0011 deg: an untextured room's points sit on its edges, where few
   // keep a plane around them.
@@ -94,14 +105,16 @@ TEST(DirectTerms, PointToPlaneAloneConvergesOnExactDepth) {
 TEST(DirectTerms, PointToPlaneFadesOutAsTheDepthNoiseReachesTheModelled) {
   const Pair exact = renderedPair(false, false), noisy = renderedPair(false, true);
   const DirectImages exact_ref = directImages(exact.a), noisy_ref = directImages(noisy.a);
-  auto sums = [](const DirectImages& ref, const LabelledCloud& b, double depth_noise) {
-    return pointToPlaneSums(ref, b, trueMotion(), depth_noise);
+  const DirectImages exact_b = directImages(exact.b), noisy_b = directImages(noisy.b);
+  auto on_exact_depth = [&](double depth_noise) {
+    return pointToPlaneAt(exact_ref, exact_b, exact.b, trueMotion(), depth_noise);
+  };
+  auto on_noisy_depth = [&](double depth_noise) {
+    return pointToPlaneAt(noisy_ref, noisy_b, noisy.b, trueMotion(), depth_noise);
   };
   // depth_noise 0 declares the depth exact: full weight, 1 / scale^2.
-  const DirectSums on_exact = sums(exact_ref, exact.b, 0.0025),
-                   full_exact = sums(exact_ref, exact.b, 0.0);
-  const DirectSums on_noisy = sums(noisy_ref, noisy.b, 0.0025),
-                   full_noisy = sums(noisy_ref, noisy.b, 0.0);
+  const DirectSums on_exact = on_exact_depth(0.0025), full_exact = on_exact_depth(0.0);
+  const DirectSums on_noisy = on_noisy_depth(0.0025), full_noisy = on_noisy_depth(0.0);
   std::printf("  learned scale: exact depth %.2e, Kinect-like noise %.2e (1/m)\n", on_exact.scale,
               on_noisy.scale);
   // Noise bends the depth at many pixels: measured 259 of the points keep a plane around them.
@@ -120,7 +133,7 @@ TEST(DirectTerms, PointToPlaneFadesOutAsTheDepthNoiseReachesTheModelled) {
   EXPECT_GT(fade(on_exact, 0.0025), 0.99);
   // A model that claims less noise than the residuals show (0.001: half of its sqrt(2) 0.001 is
   // below the learned 8e-4) gives the term no weight.
-  EXPECT_EQ(sums(noisy_ref, noisy.b, 0.001).H.trace(), 0.0);
+  EXPECT_EQ(on_noisy_depth(0.001).H.trace(), 0.0);
 }
 
 TEST(DirectTerms, PointsOnADepthEdgeOrOccludedAreLeftOut) {
@@ -142,12 +155,12 @@ TEST(DirectTerms, PointsOnADepthEdgeOrOccludedAreLeftOut) {
   addGradients(ref);
   const DirectImages mov = directImages(c);
   // The two points beside the edge are left out, the two inside each surface kept.
-  EXPECT_EQ(photometricSums(ref, mov, c, Eigen::Isometry3d::Identity()).used, 2);
-  EXPECT_EQ(pointToPlaneSums(ref, c, Eigen::Isometry3d::Identity(), 0.0).used, 2);
+  EXPECT_EQ(photometricAt(ref, mov, c, Eigen::Isometry3d::Identity()).used, 2);
+  EXPECT_EQ(pointToPlaneAt(ref, mov, c, Eigen::Isometry3d::Identity(), 0.0).used, 2);
   // Moved 0.5 m back, every point lands where the reference sees something else: occluded.
   const Eigen::Isometry3d back(Eigen::Translation3d(0.0, 0.0, 0.5));
-  EXPECT_EQ(photometricSums(ref, mov, c, back).used, 0);
-  EXPECT_EQ(pointToPlaneSums(ref, c, back, 0.0).used, 0);
+  EXPECT_EQ(photometricAt(ref, mov, c, back).used, 0);
+  EXPECT_EQ(pointToPlaneAt(ref, mov, c, back, 0.0).used, 0);
 }
 
 // The engine as the odometry runs it, with and without the direct terms, on rendered pairs.

@@ -12,8 +12,8 @@
 
 #include "acvo/params.hpp"
 #include "acvo/registration.hpp"
-#include "acvo/registration/kernel.hpp"
 #include "acvo/registration/direct_terms.hpp"
+#include "acvo/registration/kernel.hpp"
 
 namespace acvo {
 

@@ -13,6 +13,9 @@
 // edge's position is known) and Huber's weight beyond 2 standard deviations.
 #pragma once
 
+#include <cstdint>
+#include <vector>
+
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
@@ -28,6 +31,9 @@ struct DirectImages {
   cv::Mat gx, gy;     // CV_32FC1 its central differences (a reference's: addGradients)
   cv::Mat depth;      // CV_32FC1 metres, 0 or NaN = none (the cloud's own)
   Camera camera;
+  // Per point of the cloud: whether its depth is one surface at its pixel's 4 neighbours (a
+  // grey value at a depth edge belongs to either side; a point there is never used).
+  std::vector<std::uint8_t> one_surface;
   bool empty() const { return intensity.empty() || depth.empty(); }
 };
 
@@ -40,6 +46,20 @@ DirectImages directImages(const LabelledCloud& cloud);
 // The intensity's derivatives, which a reference needs.
 void addGradients(DirectImages& images);
 
+// Where a moving point lands in the reference: point j, its position y there and its pixel
+// (u, v). Both terms read the same landings.
+struct Landing {
+  std::size_t j = 0;
+  Eigen::Vector3d y = Eigen::Vector3d::Zero();
+  double u = 0.0, v = 0.0;
+};
+// The points of `moving` (its images `moving_images`) that land inside the reference's image (one
+// pixel in, for the derivatives and the bilinear sample), in front of the camera, on the surface
+// the reference's depth shows there (not occluded), and come from one surface of their own image.
+// Empty when either cloud has no images.
+std::vector<Landing> landings(const DirectImages& reference, const DirectImages& moving_images,
+                              const LabelledCloud& moving, const Eigen::Isometry3d& T);
+
 // Gauss-Newton sums of 1/2 sum rho(r_j / s) for a left perturbation xi = (omega, v) of T
 // (the step is H^-1 g), s the learned scale.
 struct DirectSums {
@@ -49,19 +69,16 @@ struct DirectSums {
   double scale = 0.0;  // their learned scale (grey levels; metres per metre^2 of depth)
 };
 
-// r_j = I_ref(pi(T z_j)) - I_moving(pixel_j). Left out: points that project outside the image
-// or behind the camera, points on a depth discontinuity of their own image (their grey value
-// belongs to either side), and points whose depth disagrees with the reference's where they
-// project (occluded there).
-DirectSums photometricSums(const DirectImages& reference, const DirectImages& moving,
-                           const LabelledCloud& moving_cloud, const Eigen::Isometry3d& T);
+// r_j = I_ref(pi(T z_j)) - I_moving(pixel_j) over the landed points.
+DirectSums photometricSums(const DirectImages& reference, const DirectImages& moving_images,
+                           const LabelledCloud& moving, const std::vector<Landing>& landed);
 
 // r_j = n^T (T z_j - x) / z_j^2, x the reference's point at the pixel where T z_j projects and
-// n the normal of its depth there (the same points left out). The weights fade with the learned
-// scale s: (1 - s / (kPlaneFade sqrt(2) depth_noise)), none beyond; depth_noise 0 = exact depth,
-// full weight.
+// n the normal of its depth there, over the landed points where the reference's surface does not
+// fold. The weights fade with the learned scale s: (1 - s / (kPlaneFade sqrt(2) depth_noise)),
+// none beyond; depth_noise 0 = exact depth, full weight.
 constexpr double kPlaneFade = 0.5;
-DirectSums pointToPlaneSums(const DirectImages& reference, const LabelledCloud& moving_cloud,
-                            const Eigen::Isometry3d& T, double depth_noise);
+DirectSums pointToPlaneSums(const DirectImages& reference, const std::vector<Landing>& landed,
+                            double depth_noise);
 
 }  // namespace acvo

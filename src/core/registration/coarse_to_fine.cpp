@@ -51,15 +51,16 @@ double addDirectTerms(const LevelSums& s, double ell, const LevelDirect& direct,
   if (!(to_units > 0.0)) return 0.0;
   H = s.H * to_units;
   g = s.g * to_units;
+  const std::vector<Landing> landed =
+      landings(*direct.reference, *direct.moving, *direct.moving_cloud, T);
   if (p.photometric) {
     const DirectSums d =
-        photometricSums(*direct.reference, *direct.moving, *direct.moving_cloud, T);
+        photometricSums(*direct.reference, *direct.moving, *direct.moving_cloud, landed);
     H += d.H;
     g += d.g;
   }
   if (p.point_to_plane) {
-    const DirectSums d =
-        pointToPlaneSums(*direct.reference, *direct.moving_cloud, T, p.depth_noise);
+    const DirectSums d = pointToPlaneSums(*direct.reference, landed, p.depth_noise);
     H += d.H;
     g += d.g;
   }

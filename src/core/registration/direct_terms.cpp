@@ -53,29 +53,6 @@ float bilinear(const cv::Mat& image, double u, double v) {
   return (1.0f - b) * ((1.0f - a) * r0[0] + a * r0[1]) + b * ((1.0f - a) * r1[0] + a * r1[1]);
 }
 
-// Where a moving point lands in the reference: its position y there and pixel (u, v), when it
-// lands inside the image (one pixel in, for the derivatives and the bilinear sample), in front
-// of the camera, on the surface the reference's depth shows there, and comes from a point of
-// one surface in its own image.
-struct Landing {
-  Eigen::Vector3d y;
-  double u = 0.0, v = 0.0;
-};
-bool land(const DirectImages& reference, const LabelledCloud& moving, std::size_t j,
-          const Eigen::Isometry3d& T, Landing& out) {
-  const Camera& cam = reference.camera;
-  out.y = T * moving.points[j].cast<double>();
-  if (!(out.y.z() > 0.0)) return false;
-  out.u = cam.fx * out.y.x() / out.y.z() + cam.cx;
-  out.v = cam.fy * out.y.y() / out.y.z() + cam.cy;
-  const cv::Mat& D = reference.depth;
-  if (!(out.u >= 1.0 && out.v >= 1.0 && out.u < D.cols - 2.0 && out.v < D.rows - 2.0)) {
-    return false;
-  }
-  return sameSurface(D.at<float>(int(std::lround(out.v)), int(std::lround(out.u))), float(out.y.z())) &&
-         smoothAround(moving.depth, moving.pixels[j], moving.points[j].z());
-}
-
 // One residual, its Jacobian for a left perturbation, and how much it says about the motion
 // (its squared sensitivity to a shift: the squared intensity gradient, or 1).
 struct Residual {
@@ -123,11 +100,17 @@ DirectSums sumsOf(std::vector<Residual>& residuals, double min_scale, double pos
 
 DirectImages directImages(const LabelledCloud& cloud) {
   DirectImages out;
-  if (cloud.gray.empty() || cloud.depth.empty()) return out;
+  if (cloud.gray.empty() || cloud.depth.empty() || cloud.pixels.size() != cloud.size()) {
+    return out;
+  }
   cloud.gray.convertTo(out.intensity, CV_32F);
   cv::GaussianBlur(out.intensity, out.intensity, cv::Size(0, 0), kSmoothing);
   out.depth = cloud.depth;
   out.camera = cloud.camera;
+  out.one_surface.resize(cloud.size());
+  for (std::size_t j = 0; j < cloud.size(); ++j) {
+    out.one_surface[j] = smoothAround(cloud.depth, cloud.pixels[j], cloud.points[j].z());
+  }
   return out;
 }
 
@@ -138,21 +121,42 @@ void addGradients(DirectImages& images) {
   cv::Sobel(images.intensity, images.gy, CV_32F, 0, 1, 1, 0.5);
 }
 
-DirectSums photometricSums(const DirectImages& reference, const DirectImages& moving,
-                           const LabelledCloud& moving_cloud, const Eigen::Isometry3d& T) {
-  if (reference.empty() || reference.gx.empty() || moving.empty() ||
-      moving_cloud.pixels.size() != moving_cloud.size()) {
-    return {};
+std::vector<Landing> landings(const DirectImages& reference, const DirectImages& moving_images,
+                              const LabelledCloud& moving, const Eigen::Isometry3d& T) {
+  std::vector<Landing> out;
+  if (reference.empty() || moving_images.empty() ||
+      moving_images.one_surface.size() != moving.size()) {
+    return out;
   }
+  out.reserve(moving.size());
+  const Camera& cam = reference.camera;
+  const cv::Mat& D = reference.depth;
+  Landing l;
+  for (l.j = 0; l.j < moving.size(); ++l.j) {
+    if (!moving_images.one_surface[l.j]) continue;
+    l.y = T * moving.points[l.j].cast<double>();
+    if (!(l.y.z() > 0.0)) continue;
+    l.u = cam.fx * l.y.x() / l.y.z() + cam.cx;
+    l.v = cam.fy * l.y.y() / l.y.z() + cam.cy;
+    if (!(l.u >= 1.0 && l.v >= 1.0 && l.u < D.cols - 2.0 && l.v < D.rows - 2.0)) continue;
+    if (!sameSurface(D.at<float>(int(std::lround(l.v)), int(std::lround(l.u))), float(l.y.z()))) {
+      continue;
+    }
+    out.push_back(l);
+  }
+  return out;
+}
+
+DirectSums photometricSums(const DirectImages& reference, const DirectImages& moving_images,
+                           const LabelledCloud& moving, const std::vector<Landing>& landed) {
+  if (reference.gx.empty() || moving_images.empty()) return {};
   const Camera& cam = reference.camera;
   std::vector<Residual> residuals;
-  residuals.reserve(moving_cloud.size());
-  Landing l;
-  for (std::size_t j = 0; j < moving_cloud.size(); ++j) {
-    if (!land(reference, moving_cloud, j, T, l)) continue;
-    const cv::Point& px = moving_cloud.pixels[j];
+  residuals.reserve(landed.size());
+  for (const Landing& l : landed) {
+    const cv::Point& px = moving.pixels[l.j];
     const double r = double(bilinear(reference.intensity, l.u, l.v)) -
-                     double(moving.intensity.at<float>(px.y, px.x));
+                     double(moving_images.intensity.at<float>(px.y, px.x));
     const double gu = bilinear(reference.gx, l.u, l.v), gv = bilinear(reference.gy, l.u, l.v);
     // d r / d y = [gu gv] d pi / d y; d y / d xi = [-hat(y), I], and (-hat(y))^T d = y x d.
     const double iz = 1.0 / l.y.z();
@@ -165,20 +169,15 @@ DirectSums photometricSums(const DirectImages& reference, const DirectImages& mo
   return sumsOf(residuals, kMinIntensityScale, kEdgePosition2, [](double) { return 1.0; });
 }
 
-DirectSums pointToPlaneSums(const DirectImages& reference, const LabelledCloud& moving_cloud,
-                            const Eigen::Isometry3d& T, double depth_noise) {
-  if (reference.empty() || moving_cloud.depth.empty() ||
-      moving_cloud.pixels.size() != moving_cloud.size()) {
-    return {};
-  }
+DirectSums pointToPlaneSums(const DirectImages& reference, const std::vector<Landing>& landed,
+                            double depth_noise) {
+  if (reference.empty()) return {};
   const Camera& cam = reference.camera;
   const cv::Mat& D = reference.depth;
   auto pointAt = [&](int u, int v) { return cam.backProject(u, v, double(D.at<float>(v, u))); };
   std::vector<Residual> residuals;
-  residuals.reserve(moving_cloud.size());
-  Landing l;
-  for (std::size_t j = 0; j < moving_cloud.size(); ++j) {
-    if (!land(reference, moving_cloud, j, T, l)) continue;
+  residuals.reserve(landed.size());
+  for (const Landing& l : landed) {
     const int u = int(std::lround(l.u)), v = int(std::lround(l.v));
     if (!smoothAround(D, cv::Point(u, v), D.at<float>(v, u))) continue;
     const Eigen::Vector3d x = pointAt(u, v);
