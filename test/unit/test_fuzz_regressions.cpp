@@ -39,7 +39,7 @@ acvo::Frame wallFrame(double fx, double fy, double cx, double cy) {
 
 std::vector<int> candidatesOf(const acvo::VoxelGrid& grid, const Eigen::Vector3f& q) {
   std::vector<int> found;
-  grid.forEachCandidate(q, [&](int i) { found.push_back(i); });
+  grid.forEachCandidate(q, [&](int i, const Eigen::Vector3f& /*x*/) { found.push_back(i); });
   return found;
 }
 

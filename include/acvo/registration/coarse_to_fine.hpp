@@ -35,10 +35,8 @@ std::vector<double> levelElls(const CoarseToFineParams& p);
 // z / reference clamped to [kMinEllScale, kMaxEllScale]; 1 when off.
 constexpr float kMinEllScale = 0.5f, kMaxEllScale = 3.0f;
 float ellScale(float z, const CoarseToFineParams& p);
-// Whether the kernel is shaped per point (ell_depth_reference or depth_noise set), and the
-// largest factor by which a point's search radius may then exceed the unit radius.
+// Whether the kernel is shaped per point (ell_depth_reference or depth_noise set).
 bool perPointKernel(const CoarseToFineParams& p);
-float maxEllScale(const CoarseToFineParams& p);
 
 // What one kernel pass sums over the kept pairs at a transform.
 struct LevelSums {

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -28,9 +29,13 @@ double sparsificationThreshold(int order, double tolerance);
 // survive sparsification whatever its colour. Zero when even d = 0 does not survive.
 double spatialRadius2(double ell, double sigma, double threshold);
 
-// Cell of a search grid serving radii up to that of length-scale `ell` (times max_scale, the
-// largest factor by which a point's own radius may exceed it).
-float gridCell(double ell, double sigma, double sparsification, float max_scale = 1.0f);
+// The radius candidate lists are built with for a kernel radius r: a margin beyond it lets
+// several iterations reuse them.
+inline float listRadius(float r) { return 1.3f * r + 0.002f; }
+
+// Cell of a search grid for the radius of length-scale `ell` (queries of other radii cover more
+// or fewer cells).
+float gridCell(double ell, double sigma, double sparsification);
 
 // Colour factor sigma_c^2 exp(-|f - g|^2 / 2 ell_c^2).
 inline float colorFactor(const Label& f, const Label& g, float color_ell2x2_inv,
@@ -38,8 +43,11 @@ inline float colorFactor(const Label& f, const Label& g, float color_ell2x2_inv,
   return color_sigma2 * std::exp(-(f - g).squaredNorm() * color_ell2x2_inv);
 }
 
-// A uniform grid over a cloud's bounding box; cells of `cell` metres. Points are stored in cell
-// order so that a row of cells along x is one contiguous range.
+// A search grid over a cloud: square columns of `cell` metres in x and y, each column's points
+// sorted by z. A camera's cloud spans metres in depth but holds about one surface per viewing
+// ray, so columns keep the index small (a dense 3-D grid at the finest search radius would need
+// millions of cells) and a query reads only the few points of the columns it covers whose z
+// is in range.
 class VoxelGrid {
  public:
   VoxelGrid() = default;
@@ -47,17 +55,24 @@ class VoxelGrid {
 
   float cell() const { return cell_; }
   bool empty() const { return order_.empty(); }
-  // Calls f(index) for every point in the 3x3x3 cells around q (a superset of the points
-  // within `cell` of q).
+  // Calls f(index, point) for every point in the box of half-width `radius` around q, so for
+  // every point within `radius` of q (and a few more from the columns' corners).
   template <typename F>
-  void forEachCandidate(const Eigen::Vector3f& q, F&& f) const;
+  void forEachWithin(const Eigen::Vector3f& q, float radius, F&& f) const;
+  // forEachWithin(q, cell()).
+  template <typename F>
+  void forEachCandidate(const Eigen::Vector3f& q, F&& f) const {
+    forEachWithin(q, cell_, std::forward<F>(f));
+  }
 
  private:
   float cell_ = 0.0f;
-  Eigen::Vector3f origin_ = Eigen::Vector3f::Zero();
-  int nx_ = 0, ny_ = 0, nz_ = 0;
-  std::vector<int> cell_start_;  // size nx*ny*nz + 1
-  std::vector<int> order_;       // point indices sorted by cell
+  Eigen::Vector2f origin_ = Eigen::Vector2f::Zero();
+  int nx_ = 0, ny_ = 0;
+  std::vector<int> column_start_;  // size nx*ny + 1
+  std::vector<int> order_;         // point indices by column, by z within a column
+  std::vector<float> z_;           // their z, in the same order
+  std::vector<Eigen::Vector3f> points_;  // the points, in the same order (read contiguously)
 };
 
 // The kernel's constants as the per-pair loops use them.
@@ -98,21 +113,19 @@ class CandidateLists {
     Eigen::ArrayXf scratch_d2, scratch_a;  // work buffers as long as the chunk's longest list
   };
 
-  // `grid` indexes the fixed cloud's points; its cell must be at least the largest search
-  // radius used.
+  // `grid` indexes the fixed cloud's points (any cell: queries cover their own radius).
   CandidateLists(const LabelledCloud& fixed, const LabelledCloud& moving, const VoxelGrid& grid,
                  const KernelConstants& k);
 
-  // Per moving point, its search radius as a multiple of the unit radius, with their smallest
-  // and the largest they may reach (default: all 1). Invalidates the lists.
-  void setSearchScales(std::vector<float> scales, float min_scale, float max_scale);
+  // Per moving point, its search radius as a multiple of the unit radius, and their smallest
+  // (default: all 1). Invalidates the lists.
+  void setSearchScales(std::vector<float> scales, float min_scale);
   float searchScale(int j) const { return search_scale_[std::size_t(j)]; }
 
   // Makes the lists valid for the moving points placed by T and searched within r times their
   // scale. Lists are built with a margin so that several iterations reuse them; they are rebuilt
   // when a point may have left the margin, or when the radius has shrunk so much that they carry
-  // mostly useless candidates. The margin never exceeds the grid cell (the grid only guarantees
-  // neighbours within one cell).
+  // mostly useless candidates.
   void update(const Eigen::Isometry3d& T, float r);
 
   int chunks() const { return int(chunks_.size()); }
@@ -127,7 +140,7 @@ class CandidateLists {
   const VoxelGrid& grid_;
   KernelConstants k_;
   std::vector<float> search_scale_;
-  float min_scale_ = 1.0f, max_scale_ = 1.0f;
+  float min_scale_ = 1.0f;
   std::vector<Chunk> chunks_;
   // The lists stay valid while every moving point stays within radius_ - r of where it was at
   // T_ (r: the current search radius).
@@ -142,24 +155,28 @@ LabelledCloud stridedSubset(const LabelledCloud& cloud, int count);
 
 // ---------------------------------------------------------------------------------------------
 template <typename F>
-void VoxelGrid::forEachCandidate(const Eigen::Vector3f& q, F&& f) const {
+void VoxelGrid::forEachWithin(const Eigen::Vector3f& q, float radius, F&& f) const {
   if (order_.empty()) return;
-  const Eigen::Vector3f r = ((q - origin_) / cell_).array().floor();
-  // Range check before the conversion to int: a query far outside the grid, or not finite,
-  // would not fit an int (undefined behaviour); NaN fails every comparison.
-  if (!(r.x() >= -1.0f && r.y() >= -1.0f && r.z() >= -1.0f && r.x() <= float(nx_) &&
-        r.y() <= float(ny_) && r.z() <= float(nz_))) {
-    return;
-  }
-  const int cx = static_cast<int>(r.x()), cy = static_cast<int>(r.y()),
-            cz = static_cast<int>(r.z());
-  const int x0 = std::max(cx - 1, 0), x1 = std::min(cx + 1, nx_ - 1);
-  if (x0 > x1) return;
-  for (int z = std::max(cz - 1, 0); z <= std::min(cz + 1, nz_ - 1); ++z) {
-    for (int y = std::max(cy - 1, 0); y <= std::min(cy + 1, ny_ - 1); ++y) {
-      const int row = (z * ny_ + y) * nx_;
-      const int begin = cell_start_[row + x0], end = cell_start_[row + x1 + 1];
-      for (int k = begin; k < end; ++k) f(order_[k]);
+  // Column range in float first: a query far outside the grid, or not finite, would not fit an
+  // int (undefined behaviour); NaN fails every comparison.
+  const float x_lo = std::floor((q.x() - radius - origin_.x()) / cell_);
+  const float x_hi = std::floor((q.x() + radius - origin_.x()) / cell_);
+  const float y_lo = std::floor((q.y() - radius - origin_.y()) / cell_);
+  const float y_hi = std::floor((q.y() + radius - origin_.y()) / cell_);
+  if (!(x_hi >= 0.0f && y_hi >= 0.0f && x_lo < float(nx_) && y_lo < float(ny_))) return;
+  const float z_lo = q.z() - radius, z_hi = q.z() + radius;
+  if (!(z_lo <= z_hi)) return;
+  const int x0 = int(std::max(x_lo, 0.0f)), x1 = int(std::min(x_hi, float(nx_ - 1)));
+  const int y0 = int(std::max(y_lo, 0.0f)), y1 = int(std::min(y_hi, float(ny_ - 1)));
+  for (int y = y0; y <= y1; ++y) {
+    for (int x = x0; x <= x1; ++x) {
+      const int column = y * nx_ + x;
+      const auto begin = z_.begin() + column_start_[std::size_t(column)];
+      const auto end = z_.begin() + column_start_[std::size_t(column) + 1];
+      for (auto k = std::lower_bound(begin, end, z_lo); k != end && *k <= z_hi; ++k) {
+        const std::size_t at = std::size_t(k - z_.begin());
+        f(order_[at], points_[at]);
+      }
     }
   }
 }

@@ -139,8 +139,7 @@ double prepareCoarseToFineReference(CoarseToFineCloud& cloud, const CoarseToFine
   if (cloud.reference) return 0.0;
   const auto t0 = Clock::now();
   for (double ell : levelElls(p)) {
-    cloud.level_grids.emplace_back(cloud.cloud.points,
-                                   gridCell(ell, p.sigma, p.sparsification, maxEllScale(p)));
+    cloud.level_grids.emplace_back(cloud.cloud.points, gridCell(ell, p.sigma, p.sparsification));
   }
   addGradients(cloud.images);
   cloud.reference = true;

@@ -50,52 +50,65 @@ VoxelGrid::VoxelGrid(const std::vector<Eigen::Vector3f>& points, float cell) : c
   auto finite = [](const Eigen::Vector3f& p) { return p.allFinite(); };
   const auto first = std::find_if(points.begin(), points.end(), finite);
   if (first == points.end()) return;
-  Eigen::Vector3f lo = *first, hi = *first;
+  Eigen::Vector2f lo = first->head<2>(), hi = first->head<2>();
   for (const auto& p : points) {
     if (!finite(p)) continue;
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
+    lo = lo.cwiseMin(p.head<2>());
+    hi = hi.cwiseMax(p.head<2>());
   }
   // A cloud spread far beyond the radius would make a huge dense grid: coarsen the cells then
   // (candidates stay a superset of the true neighbours, searches only get slower). The extent is
   // taken in double: hi - lo of finite floats may overflow float.
-  constexpr double kMaxCells = 4e6;
-  const Eigen::Vector3d extent = hi.cast<double>() - lo.cast<double>();
+  constexpr double kMaxColumns = 4e6;
+  const Eigen::Vector2d extent = hi.cast<double>() - lo.cast<double>();
   for (;;) {
-    const Eigen::Vector3d n = (extent / double(cell_)).array().floor() + 1.0;
-    if (n.x() * n.y() * n.z() <= kMaxCells) {
-      nx_ = int(n.x()), ny_ = int(n.y()), nz_ = int(n.z());
+    const Eigen::Vector2d n = (extent / double(cell_)).array().floor() + 1.0;
+    if (n.x() * n.y() <= kMaxColumns) {
+      nx_ = int(n.x()), ny_ = int(n.y());
       break;
     }
     cell_ *= 1.5f;
   }
   origin_ = lo;
-  const int cells = nx_ * ny_ * nz_;
-  const Eigen::Vector3f top(float(nx_ - 1), float(ny_ - 1), float(nz_ - 1));
-  std::vector<int> cell_of(points.size(), -1);
-  cell_start_.assign(cells + 1, 0);
+  const int columns = nx_ * ny_;
+  const Eigen::Vector2f top(float(nx_ - 1), float(ny_ - 1));
+  std::vector<int> column_of(points.size(), -1);
+  column_start_.assign(std::size_t(columns) + 1, 0);
   for (std::size_t i = 0; i < points.size(); ++i) {
     if (!finite(points[i])) continue;
     // Clamped before the conversion to int: p - origin may overflow float to +inf.
-    const Eigen::Vector3f r = ((points[i] - origin_) / cell_).cwiseMin(top);
-    const int x = int(r.x()), y = int(r.y()), z = int(r.z());
-    cell_of[i] = (z * ny_ + y) * nx_ + x;
-    ++cell_start_[cell_of[i] + 1];
+    const Eigen::Vector2f r = ((points[i].head<2>() - origin_) / cell_).cwiseMin(top);
+    column_of[i] = int(r.y()) * nx_ + int(r.x());
+    ++column_start_[std::size_t(column_of[i]) + 1];
   }
-  for (int c = 0; c < cells; ++c) cell_start_[c + 1] += cell_start_[c];
-  order_.resize(cell_start_.back());
-  std::vector<int> fill(cell_start_.begin(), cell_start_.end() - 1);
+  for (int c = 0; c < columns; ++c) column_start_[std::size_t(c) + 1] += column_start_[std::size_t(c)];
+  order_.resize(std::size_t(column_start_.back()));
+  std::vector<int> fill(column_start_.begin(), column_start_.end() - 1);
   for (std::size_t i = 0; i < points.size(); ++i) {
-    if (cell_of[i] >= 0) order_[fill[cell_of[i]]++] = int(i);
+    if (column_of[i] >= 0) order_[std::size_t(fill[std::size_t(column_of[i])]++)] = int(i);
+  }
+  z_.resize(order_.size());
+  for (int c = 0; c < columns; ++c) {
+    const auto begin = order_.begin() + column_start_[std::size_t(c)];
+    const auto end = order_.begin() + column_start_[std::size_t(c) + 1];
+    if (end - begin > 1) {
+      std::sort(begin, end, [&](int a, int b) {
+        return points[std::size_t(a)].z() < points[std::size_t(b)].z();
+      });
+    }
+  }
+  points_.resize(order_.size());
+  for (std::size_t k = 0; k < order_.size(); ++k) {
+    points_[k] = points[std::size_t(order_[k])];
+    z_[k] = points_[k].z();
   }
 }
 
-float gridCell(double ell, double sigma, double sparsification, float max_scale) {
+float gridCell(double ell, double sigma, double sparsification) {
   const double r2 = spatialRadius2(ell, sigma, sparsification);
-  // Cells a little larger than the search radius: the candidate lists carry a margin beyond the
-  // radius and a grid only guarantees neighbours within one cell.
-  return (std::isfinite(r2) && r2 > 0.0 ? 1.3f * float(std::sqrt(r2)) + 0.002f : 0.1f) *
-         max_scale;
+  // The radius the candidate lists are built with (CandidateLists::update: a margin beyond the
+  // kernel's radius).
+  return std::isfinite(r2) && r2 > 0.0 ? listRadius(float(std::sqrt(r2))) : 0.1f;
 }
 
 KernelConstants kernelConstants(double sigma, double color_ell, double color_sigma,
@@ -117,11 +130,9 @@ CandidateLists::CandidateLists(const LabelledCloud& fixed, const LabelledCloud& 
       search_scale_(moving.size(), 1.0f),
       chunks_((moving.size() + kChunk - 1) / kChunk) {}
 
-void CandidateLists::setSearchScales(std::vector<float> scales, float min_scale,
-                                     float max_scale) {
+void CandidateLists::setSearchScales(std::vector<float> scales, float min_scale) {
   search_scale_ = std::move(scales);
   min_scale_ = min_scale;
-  max_scale_ = max_scale;
   valid_ = false;
   radius_ = 0.0f;
 }
@@ -138,20 +149,21 @@ void CandidateLists::update(const Eigen::Isometry3d& T, float r) {
     // In units of each point's own search radius the smallest scale moved the most.
     moved = std::sqrt(worst2) / min_scale_;
   }
-  const float cell = grid_.cell() / max_scale_;
-  if (r + moved > radius_ || radius_ > 1.6f * r + 0.005f) {
-    build(T, std::min(1.3f * r + 0.002f, std::max(cell, r)));
-  }
+  if (r + moved > radius_ || radius_ > 1.6f * r + 0.005f) build(T, listRadius(r));
 }
 
 void CandidateLists::build(const Eigen::Isometry3d& T, float radius) {
   const Eigen::Matrix3f R = T.linear().cast<float>();
   const Eigen::Vector3f t = T.translation().cast<float>();
-  const auto& X = fixed_.points;
   const auto& fx = fixed_.labels;
   const auto& Z = moving_.points;
   const auto& gz = moving_.labels;
   const int n = int(Z.size());
+  // sigma^2 colorFactor >= sparsification as a bound on the label distance: most pairs in reach
+  // fail on colour, and the bound spares them the exponential.
+  const float ratio = k_.sigma2 * k_.color_sigma2 / k_.sparsification;
+  const float label_d2_max =
+      !(ratio >= 1.0f) ? -1.0f : (k_.color_inv > 0.0f ? std::log(ratio) / k_.color_inv : INFINITY);
   forEachChunk(int(chunks_.size()), [&](int c) {
     Chunk& chunk = chunks_[std::size_t(c)];
     chunk.end.clear();
@@ -166,16 +178,17 @@ void CandidateLists::build(const Eigen::Isometry3d& T, float radius) {
       const Eigen::Vector3f y = R * Z[std::size_t(j)] + t;
       const float rj = radius * search_scale_[std::size_t(j)];
       const float radius2 = rj * rj;
-      grid_.forEachCandidate(y, [&](int i) {
-        if (!((X[std::size_t(i)] - y).squaredNorm() < radius2)) return;
+      grid_.forEachWithin(y, rj, [&](int i, const Eigen::Vector3f& x) {
+        if (!((x - y).squaredNorm() < radius2)) return;
+        if (!((fx[std::size_t(i)] - gz[std::size_t(j)]).squaredNorm() <= label_d2_max)) return;
         const float cf = colorFactor(fx[std::size_t(i)], gz[std::size_t(j)], k_.color_inv,
                                      k_.color_sigma2);
         if (k_.sigma2 * cf < k_.sparsification) return;  // fails at any distance
         chunk.i.push_back(i);
         chunk.color.push_back(cf);
-        chunk.x.push_back(X[std::size_t(i)].x());
-        chunk.y.push_back(X[std::size_t(i)].y());
-        chunk.z.push_back(X[std::size_t(i)].z());
+        chunk.x.push_back(x.x());
+        chunk.y.push_back(x.y());
+        chunk.z.push_back(x.z());
       });
       chunk.end.push_back(int(chunk.i.size()));
       longest = std::max(longest, chunk.end.back() - start);

@@ -19,10 +19,6 @@ bool perPointKernel(const CoarseToFineParams& p) {
   return p.ell_depth_reference > 0.0 || p.depth_noise > 0.0;
 }
 
-float maxEllScale(const CoarseToFineParams& p) {
-  return perPointKernel(p) ? kMaxEllScale : 1.0f;
-}
-
 LevelKernel::LevelKernel(const LabelledCloud& fixed, const LabelledCloud& moving,
                          const VoxelGrid& grid, const CoarseToFineParams& params)
     : fixed_(fixed),
@@ -51,7 +47,7 @@ void LevelKernel::shapeFor(double ell) {
     min_scale = std::min(min_scale, search[j]);
   }
   // New shapes, new lists.
-  lists_.setSearchScales(std::move(search), min_scale, maxEllScale(params_));
+  lists_.setSearchScales(std::move(search), min_scale);
 }
 
 const LevelSums& LevelKernel::evaluate(const Eigen::Isometry3d& T, double ell) {

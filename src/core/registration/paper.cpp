@@ -114,9 +114,9 @@ std::shared_ptr<PaperCloud> preparePaper(LabelledCloud cloud, const PaperParams&
   const auto& pts = out->cloud.points;
   const auto& labels = out->cloud.labels;
   for (int i = 0; i < int(pts.size()); ++i) {
-    out->grid.forEachCandidate(pts[std::size_t(i)], [&](int j) {
+    out->grid.forEachCandidate(pts[std::size_t(i)], [&](int j, const Eigen::Vector3f& x) {
       if (j <= i) return;
-      const float d2 = (pts[std::size_t(i)] - pts[std::size_t(j)]).squaredNorm();
+      const float d2 = (pts[std::size_t(i)] - x).squaredNorm();
       if (!(d2 < r2)) return;
       const float c = colorFactor(labels[std::size_t(i)], labels[std::size_t(j)], k.color_inv,
                                   k.color_sigma2);
