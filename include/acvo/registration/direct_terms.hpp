@@ -28,7 +28,6 @@ namespace acvo {
 // A cloud's images as the terms read them.
 struct DirectImages {
   cv::Mat intensity;  // CV_32FC1 grey levels, smoothed by a Gaussian of kSmoothing pixels
-  cv::Mat gx, gy;     // CV_32FC1 its central differences (a reference's: addGradients)
   cv::Mat depth;      // CV_32FC1 metres, 0 or NaN = none (the cloud's own)
   Camera camera;
   // Per point of the cloud: whether its depth is one surface at its pixel's 4 neighbours (a
@@ -43,8 +42,6 @@ constexpr double kSmoothing = 0.7;
 
 // From the cloud's grey and depth images (empty when the cloud has none).
 DirectImages directImages(const LabelledCloud& cloud);
-// The intensity's derivatives, which a reference needs.
-void addGradients(DirectImages& images);
 
 // Where a moving point lands in the reference: point j, its position y there and its pixel
 // (u, v). Both terms read the same landings.

@@ -141,7 +141,6 @@ double prepareCoarseToFineReference(CoarseToFineCloud& cloud, const CoarseToFine
   for (double ell : levelElls(p)) {
     cloud.level_grids.emplace_back(cloud.cloud.points, gridCell(ell, p.sigma, p.sparsification));
   }
-  addGradients(cloud.images);
   cloud.reference = true;
   const double ms = msSince(t0);
   cloud.ms_prepare += ms;

@@ -53,6 +53,25 @@ float bilinear(const cv::Mat& image, double u, double v) {
   return (1.0f - b) * ((1.0f - a) * r0[0] + a * r0[1]) + b * ((1.0f - a) * r1[0] + a * r1[1]);
 }
 
+// The bilinear sample at (u, v) of the image's central differences 0.5 (I[x+1] - I[x-1]) and
+// 0.5 (I[y+1] - I[y-1]), from the image itself at (u, v) in [1, cols - 2) x [1, rows - 2): a few
+// thousand samples per iteration, where differentiating a reference's whole image
+// (cv::Sobel) cost a few milliseconds per keyframe.
+Eigen::Vector2d bilinearGradient(const cv::Mat& image, double u, double v) {
+  const int x = int(u), y = int(v);
+  const float a = float(u - x), b = float(v - y);
+  const float* rm = image.ptr<float>(y - 1) + x;
+  const float* r0 = image.ptr<float>(y) + x;
+  const float* r1 = image.ptr<float>(y + 1) + x;
+  const float* r2 = image.ptr<float>(y + 2) + x;
+  auto across = [a](const float* r) { return (1.0f - a) * (r[1] - r[-1]) + a * (r[2] - r[0]); };
+  auto down = [a](const float* lo, const float* hi) {
+    return (1.0f - a) * (hi[0] - lo[0]) + a * (hi[1] - lo[1]);
+  };
+  return {0.5 * double((1.0f - b) * across(r0) + b * across(r1)),
+          0.5 * double((1.0f - b) * down(rm, r1) + b * down(r0, r2))};
+}
+
 // One residual, its Jacobian for a left perturbation, and how much it says about the motion
 // (its squared sensitivity to a shift: the squared intensity gradient, or 1).
 struct Residual {
@@ -114,13 +133,6 @@ DirectImages directImages(const LabelledCloud& cloud) {
   return out;
 }
 
-void addGradients(DirectImages& images) {
-  if (images.intensity.empty() || !images.gx.empty()) return;
-  // ksize 1: the plain [-1 0 1] difference, halved: central differences.
-  cv::Sobel(images.intensity, images.gx, CV_32F, 1, 0, 1, 0.5);
-  cv::Sobel(images.intensity, images.gy, CV_32F, 0, 1, 1, 0.5);
-}
-
 std::vector<Landing> landings(const DirectImages& reference, const DirectImages& moving_images,
                               const LabelledCloud& moving, const Eigen::Isometry3d& T) {
   std::vector<Landing> out;
@@ -149,7 +161,7 @@ std::vector<Landing> landings(const DirectImages& reference, const DirectImages&
 
 DirectSums photometricSums(const DirectImages& reference, const DirectImages& moving_images,
                            const LabelledCloud& moving, const std::vector<Landing>& landed) {
-  if (reference.gx.empty() || moving_images.empty()) return {};
+  if (reference.empty() || moving_images.empty()) return {};
   const Camera& cam = reference.camera;
   std::vector<Residual> residuals;
   residuals.reserve(landed.size());
@@ -157,7 +169,8 @@ DirectSums photometricSums(const DirectImages& reference, const DirectImages& mo
     const cv::Point& px = moving.pixels[l.j];
     const double r = double(bilinear(reference.intensity, l.u, l.v)) -
                      double(moving_images.intensity.at<float>(px.y, px.x));
-    const double gu = bilinear(reference.gx, l.u, l.v), gv = bilinear(reference.gy, l.u, l.v);
+    const Eigen::Vector2d grad = bilinearGradient(reference.intensity, l.u, l.v);
+    const double gu = grad.x(), gv = grad.y();
     // d r / d y = [gu gv] d pi / d y; d y / d xi = [-hat(y), I], and (-hat(y))^T d = y x d.
     const double iz = 1.0 / l.y.z();
     const Eigen::Vector3d d(gu * cam.fx * iz, gv * cam.fy * iz,
