@@ -117,9 +117,9 @@ class CandidateLists {
   CandidateLists(const LabelledCloud& fixed, const LabelledCloud& moving, const VoxelGrid& grid,
                  const KernelConstants& k);
 
-  // Per moving point, its search radius as a multiple of the unit radius, and their smallest
-  // (default: all 1). Invalidates the lists.
-  void setSearchScales(std::vector<float> scales, float min_scale);
+  // Per moving point, its search radius as a multiple of the unit radius (default: all 1; each
+  // positive). Invalidates the lists.
+  void setSearchScales(std::vector<float> scales);
   float searchScale(int j) const { return search_scale_[std::size_t(j)]; }
 
   // Makes the lists valid for the moving points placed by T and searched within r times their
@@ -140,7 +140,6 @@ class CandidateLists {
   const VoxelGrid& grid_;
   KernelConstants k_;
   std::vector<float> search_scale_;
-  float min_scale_ = 1.0f;
   std::vector<Chunk> chunks_;
   // The lists stay valid while every moving point stays within radius_ - r of where it was at
   // T_ (r: the current search radius).

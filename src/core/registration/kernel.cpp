@@ -130,24 +130,26 @@ CandidateLists::CandidateLists(const LabelledCloud& fixed, const LabelledCloud& 
       search_scale_(moving.size(), 1.0f),
       chunks_((moving.size() + kChunk - 1) / kChunk) {}
 
-void CandidateLists::setSearchScales(std::vector<float> scales, float min_scale) {
+void CandidateLists::setSearchScales(std::vector<float> scales) {
   search_scale_ = std::move(scales);
-  min_scale_ = min_scale;
   valid_ = false;
   radius_ = 0.0f;
 }
 
 void CandidateLists::update(const Eigen::Isometry3d& T, float r) {
-  // How far the moving points have moved since the lists were built (exactly: a bound through
-  // ||dR|| |z|max is loose enough to force a rebuild after a tenth of a degree).
+  // How far the moving points have moved since the lists were built, each in units of its own
+  // search radius (exactly: a bound through ||dR|| |z|max is loose enough to force a rebuild
+  // after a tenth of a degree).
   float moved = INFINITY;
   if (valid_) {
     const Eigen::Matrix3f dR = (T.linear() - T_.linear()).cast<float>();
     const Eigen::Vector3f dt = (T.translation() - T_.translation()).cast<float>();
     float worst2 = 0.0f;
-    for (const auto& z : moving_.points) worst2 = std::max(worst2, (dR * z + dt).squaredNorm());
-    // In units of each point's own search radius the smallest scale moved the most.
-    moved = std::sqrt(worst2) / min_scale_;
+    for (std::size_t j = 0; j < moving_.size(); ++j) {
+      const float s = search_scale_[j];
+      worst2 = std::max(worst2, (dR * moving_.points[j] + dt).squaredNorm() / (s * s));
+    }
+    moved = std::sqrt(worst2);
   }
   if (r + moved > radius_ || radius_ > 1.6f * r + 0.005f) build(T, listRadius(r));
 }

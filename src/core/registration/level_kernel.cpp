@@ -34,7 +34,6 @@ LevelKernel::LevelKernel(const LabelledCloud& fixed, const LabelledCloud& moving
 void LevelKernel::shapeFor(double ell) {
   shaped_ell_ = ell;
   std::vector<float> search(moving_.size(), 1.0f);
-  float min_scale = kMaxEllScale;
   for (std::size_t j = 0; j < moving_.size(); ++j) {
     const float z = moving_.points[j].z();
     scale_[j] = ellScale(z, params_);
@@ -44,10 +43,9 @@ void LevelKernel::shapeFor(double ell) {
     const float l = float(ell) * scale_[j];
     kappa_[j] = 2.0f * noise * noise / (l * l + 2.0f * noise * noise);
     search[j] = std::min(scale_[j] / std::sqrt(1.0f - kappa_[j]), kMaxEllScale);
-    min_scale = std::min(min_scale, search[j]);
   }
   // New shapes, new lists.
-  lists_.setSearchScales(std::move(search), min_scale);
+  lists_.setSearchScales(std::move(search));
 }
 
 const LevelSums& LevelKernel::evaluate(const Eigen::Isometry3d& T, double ell) {
