@@ -1,6 +1,7 @@
 // Depth decoding into metres (TUM PNG, 16UC1 millimetres, 32FC1 metres); invalid depth as 0.
 #include "acvo/depth.hpp"
 
+#include <limits>
 #include <stdexcept>
 
 namespace acvo {
@@ -27,9 +28,22 @@ cv::Mat depthToMeters(const cv::Mat& raw, double units_per_metre) {
   }
   cv::Mat out(raw.size(), CV_32FC1);
   switch (raw.type()) {
-    case CV_16UC1:
-      convert<std::uint16_t>(raw, units_per_metre, out);
+    case CV_16UC1: {
+      const double inv = 1.0 / units_per_metre;
+      if (!(65535.0 * inv <= std::numeric_limits<float>::max())) {
+        convert<std::uint16_t>(raw, units_per_metre, out);  // some values beyond float
+        break;
+      }
+      // Raw 0 (no depth) gives 0 and every other value a positive finite one: a product by the
+      // inverse scale, without the branches, which the compiler vectorises (the division per
+      // pixel of the generic path was a tenth of a frame's selection time).
+      for (int v = 0; v < raw.rows; ++v) {
+        const std::uint16_t* in = raw.ptr<std::uint16_t>(v);
+        float* o = out.ptr<float>(v);
+        for (int u = 0; u < raw.cols; ++u) o[u] = static_cast<float>(in[u] * inv);
+      }
       break;
+    }
     case CV_32FC1:
       convert<float>(raw, units_per_metre, out);
       break;
