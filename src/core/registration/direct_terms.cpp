@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include <opencv2/imgproc.hpp>
@@ -90,15 +91,21 @@ DirectSums sumsOf(std::vector<Residual>& residuals, double min_scale, double pos
                   Weight&& weight) {
   DirectSums s;
   if (residuals.empty()) return s;
-  std::sort(residuals.begin(), residuals.end(),
-            [](const Residual& a, const Residual& b) { return std::abs(a.r) < std::abs(b.r); });
+  // The weighted median from (|r|, say) pairs sorted (sorting the residuals themselves moved
+  // their Jacobians too).
+  std::vector<std::pair<double, double>> by_size;
+  by_size.reserve(residuals.size());
   double total = 0.0;
-  for (const Residual& q : residuals) total += q.say;
-  double median = std::abs(residuals.back().r), seen = 0.0;
   for (const Residual& q : residuals) {
-    seen += q.say;
+    by_size.emplace_back(std::abs(q.r), q.say);
+    total += q.say;
+  }
+  std::sort(by_size.begin(), by_size.end());
+  double median = by_size.back().first, seen = 0.0;
+  for (const auto& [size, say] : by_size) {
+    seen += say;
     if (seen >= 0.5 * total) {
-      median = std::abs(q.r);
+      median = size;
       break;
     }
   }
