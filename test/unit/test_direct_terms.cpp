@@ -1,9 +1,13 @@
 // The default engine's last-level terms (direct_terms.hpp): each term alone converges to the
 // true motion of a rendered pair, the point-to-plane term fades where depth is Kinect-noisy,
-// points on depth edges are left out, and the engine with them resolves motion far finer than
-// its kernel alone.
+// points on depth edges are left out, the engine with them resolves motion far finer than its
+// kernel alone, and the learned scales' weighted median is a sort's.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <random>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -71,6 +75,36 @@ Eigen::Isometry3d iterate(Sums&& sums, int iterations) {
     T = normalized(expSE3(Eigen::LDLT<Matrix6d>(s.H).solve(s.g)) * T);
   }
   return T;
+}
+
+// The learned scales' weighted median equals the answer of a sort and a running sum, on random
+// values with ties, zero weights and one weight that outweighs all the rest.
+TEST(DirectTerms, WeightedMedianEqualsTheSortedAnswer) {
+  auto sorted = [](std::vector<std::pair<double, double>> v) {
+    std::sort(v.begin(), v.end());
+    double total = 0.0, seen = 0.0;
+    for (const auto& p : v) total += p.second;
+    for (const auto& p : v) {
+      seen += p.second;
+      if (seen >= 0.5 * total) return p.first;
+    }
+    return v.back().first;
+  };
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<int> value(0, 40);  // ties
+  std::uniform_real_distribution<double> weight(0.0, 1.0);
+  for (int n : {1, 2, 3, 10, 101, 2000}) {
+    for (int trial = 0; trial < 20; ++trial) {
+      std::vector<std::pair<double, double>> v;
+      for (int k = 0; k < n; ++k) {
+        const double w = trial % 4 == 0 ? 0.0 : (trial % 4 == 1 ? 1.0 : weight(rng));
+        v.emplace_back(0.1 * value(rng), w);
+      }
+      if (trial % 4 == 3) v[std::size_t(n / 2)].second = 1e6;
+      const double expected = sorted(v);
+      EXPECT_EQ(weightedMedian(v), expected) << "n " << n << " trial " << trial;
+    }
+  }
 }
 
 TEST(DirectTerms, PhotometricAloneConvergesToTheTrueMotion) {

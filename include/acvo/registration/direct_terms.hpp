@@ -14,6 +14,7 @@
 #pragma once
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -56,6 +57,11 @@ struct Landing {
 // Empty when either cloud has no images.
 std::vector<Landing> landings(const DirectImages& reference, const DirectImages& moving_images,
                               const LabelledCloud& moving, const Eigen::Isometry3d& T);
+
+// The smallest value v of the (value, weight) pairs whose weights up to v reach half of all (a
+// sort's answer in linear time: quickselect on the part that holds the crossing). Reorders the
+// pairs, which must not be empty. The terms' learned scales are weighted medians.
+double weightedMedian(std::vector<std::pair<double, double>>& pairs);
 
 // Gauss-Newton sums of 1/2 sum rho(r_j / s) for a left perturbation xi = (omega, v) of T
 // (the step is H^-1 g), s the learned scale.

@@ -91,24 +91,10 @@ DirectSums sumsOf(std::vector<Residual>& residuals, double min_scale, double pos
                   Weight&& weight) {
   DirectSums s;
   if (residuals.empty()) return s;
-  // The weighted median from (|r|, say) pairs sorted (sorting the residuals themselves moved
-  // their Jacobians too).
   std::vector<std::pair<double, double>> by_size;
   by_size.reserve(residuals.size());
-  double total = 0.0;
-  for (const Residual& q : residuals) {
-    by_size.emplace_back(std::abs(q.r), q.say);
-    total += q.say;
-  }
-  std::sort(by_size.begin(), by_size.end());
-  double median = by_size.back().first, seen = 0.0;
-  for (const auto& [size, say] : by_size) {
-    seen += say;
-    if (seen >= 0.5 * total) {
-      median = size;
-      break;
-    }
-  }
+  for (const Residual& q : residuals) by_size.emplace_back(std::abs(q.r), q.say);
+  const double median = weightedMedian(by_size);
   s.scale = std::max(1.4826 * median, min_scale);
   const double factor = weight(s.scale);
   if (!(factor > 0.0)) return s;
@@ -123,6 +109,29 @@ DirectSums sumsOf(std::vector<Residual>& residuals, double min_scale, double pos
 }
 
 }  // namespace
+
+double weightedMedian(std::vector<std::pair<double, double>>& pairs) {
+  double total = 0.0;
+  for (const auto& p : pairs) total += p.second;
+  const double half = 0.5 * total;
+  auto lo = pairs.begin(), hi = pairs.end();
+  double below = 0.0;  // the weight of the pairs before lo, all smaller
+  while (hi - lo > 1) {
+    const auto mid = lo + (hi - lo) / 2;
+    std::nth_element(lo, mid, hi);
+    double left = below;
+    for (auto p = lo; p != mid; ++p) left += p->second;
+    if (left >= half) {
+      hi = mid;
+    } else if (left + mid->second >= half) {
+      return mid->first;
+    } else {
+      below = left + mid->second;
+      lo = mid + 1;
+    }
+  }
+  return lo != pairs.end() ? lo->first : std::max_element(pairs.begin(), pairs.end())->first;
+}
 
 DirectImages directImages(const LabelledCloud& cloud) {
   DirectImages out;
