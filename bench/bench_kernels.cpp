@@ -1,7 +1,7 @@
 // acvo_bench_kernels: Google Benchmark timings of each stage of one registration, on one pair
 // of real frames (see frame_pair.hpp): pixel selection, cloud building; for the default engine
-// a reference's search grids, the kernel pass of a level (fresh and with warm candidate lists)
-// and a whole registration; for the paper's engine the cloud preparation (search grid and
+// a reference's search grids, the kernel pass of a level (fresh and with warm candidate lists),
+// the last level's direct terms and a whole registration; for the paper's engine the cloud preparation (search grid and
 // self-kernel pairs), its kernel pass, the step-size sums, the self-kernel sums and a whole
 // registration.
 //
@@ -149,6 +149,25 @@ void BM_LevelKernelWarm(benchmark::State& state) {
   state.counters["nnz"] = double(nnz);
 }
 BENCHMARK(BM_LevelKernelWarm)->Apply(levelArguments);
+
+// The last level's direct terms at one iterate: where the moving points land, then the
+// photometric and point-to-plane sums (each with its learned scale).
+void BM_DirectTerms(benchmark::State& state) {
+  int used = 0;
+  for (auto _ : state) {
+    const std::vector<acvo::Landing> landed = acvo::landings(
+        g_pair->fixed->images, g_pair->moving->images, g_pair->moving->cloud, g_pair->aligned);
+    const acvo::DirectSums a = acvo::photometricSums(g_pair->fixed->images, g_pair->moving->images,
+                                                     g_pair->moving->cloud, landed);
+    const acvo::DirectSums b = acvo::pointToPlaneSums(
+        g_pair->fixed->images, landed, g_pair->params.coarse_to_fine.depth_noise);
+    used = a.used + b.used;
+    benchmark::DoNotOptimize(a.H);
+    benchmark::DoNotOptimize(b.H);
+  }
+  state.counters["residuals"] = used;
+}
+BENCHMARK(BM_DirectTerms)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // A whole registration of the default engine from the identity guess.
 void BM_Align(benchmark::State& state) {

@@ -1,5 +1,5 @@
 // What both engines share of the kernel a_ij (docs/method.md §2, §5): its sparsification and
-// the radius it implies, the colour factor, a uniform voxel grid over a fixed cloud, and the
+// the radius it implies, the colour factor, a search grid of columns over a fixed cloud, and the
 // candidate lists that each engine's kernel pass runs over (the fixed points near each moving
 // point, rebuilt only when a point may have left their margin).
 #pragma once

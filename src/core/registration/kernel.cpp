@@ -106,9 +106,11 @@ VoxelGrid::VoxelGrid(const std::vector<Eigen::Vector3f>& points, float cell) : c
 
 float gridCell(double ell, double sigma, double sparsification) {
   const double r2 = spatialRadius2(ell, sigma, sparsification);
-  // The radius the candidate lists are built with (CandidateLists::update: a margin beyond the
-  // kernel's radius).
-  return std::isfinite(r2) && r2 > 0.0 ? listRadius(float(std::sqrt(r2))) : 0.1f;
+  // Twice the radius the candidate lists are built with (CandidateLists::update): points at 1-3 m
+  // search 1.3-3 times it, so a query covers 2-4 columns a side. Instructions of the list builds
+  // over 20 kitchen7s_dev frames (callgrind): 407 M with cells of one radius, 365 M of 1.5,
+  // 352 M of 2, 350 M of 3.
+  return std::isfinite(r2) && r2 > 0.0 ? 2.0f * listRadius(float(std::sqrt(r2))) : 0.1f;
 }
 
 KernelConstants kernelConstants(double sigma, double color_ell, double color_sigma,
