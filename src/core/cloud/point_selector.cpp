@@ -86,9 +86,10 @@ int bestCoarse(const Maps& m, int k, const Rect& cell) {
   const int s = 1 << k;
   const Rect& in = m.interior;
   // Coarse pixel x covers level-0 columns [x s, x s + s): it meets the interior when
-  // x >= x0 / s and x s < x1.
-  const Rect coarse = Rect{cell.x0 / s, cell.y0 / s, cell.x1 / s, cell.y1 / s}
-                          .clip({in.x0 / s, in.y0 / s, (in.x1 + s - 1) / s, (in.y1 + s - 1) / s})
+  // x >= x0 / s and x s < x1. (Shifts: the coordinates are not negative, and a division by a
+  // variable s made this the costliest part of a pass.)
+  const Rect coarse = Rect{cell.x0 >> k, cell.y0 >> k, cell.x1 >> k, cell.y1 >> k}
+                          .clip({in.x0 >> k, in.y0 >> k, (in.x1 + s - 1) >> k, (in.y1 + s - 1) >> k})
                           .clip({0, 0, level.width, level.height});
   if (coarse.empty()) return -1;
   const int best = bestCandidate(level, coarse);
