@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstdint>
 #include <stdexcept>
+#include <utility>
 
 #include <opencv2/imgproc.hpp>
 
@@ -79,8 +80,8 @@ struct Maps {
 };
 
 // Best candidate of level k (scale s = 2^k) whose level-0 footprint meets the interior, inside
-// the level-0 rectangle `cell` (its corners are multiples of s); mapped back to the best level-0
-// pixel of its footprint. -1 when there is none.
+// the level-0 rectangle `cell` (its corners are multiples of s): its index in level k, -1 when
+// there is none.
 int bestCoarse(const Maps& m, int k, const Rect& cell) {
   const CandidateLevel& level = m.pyr[k];
   const int s = 1 << k;
@@ -91,19 +92,49 @@ int bestCoarse(const Maps& m, int k, const Rect& cell) {
   const Rect coarse = Rect{cell.x0 >> k, cell.y0 >> k, cell.x1 >> k, cell.y1 >> k}
                           .clip({in.x0 >> k, in.y0 >> k, (in.x1 + s - 1) >> k, (in.y1 + s - 1) >> k})
                           .clip({0, 0, level.width, level.height});
-  if (coarse.empty()) return -1;
-  const int best = bestCandidate(level, coarse);
-  if (best < 0) return -1;
-  const int x = best % level.width, y = best / level.width;
-  return argmaxGradient(m.gray, Rect{x * s, y * s, x * s + s, y * s + s}.clip(in));
+  return coarse.empty() ? -1 : bestCandidate(level, coarse);
+}
+
+// A coarse pick mapped back to the level-0 pixel of its footprint with the largest gradient.
+int toLevel0(const Maps& m, int k, int coarse_index) {
+  const int s = 1 << k, width = m.pyr[k].width;
+  const int x = coarse_index % width, y = coarse_index / width;
+  return argmaxGradient(m.gray, Rect{x * s, y * s, x * s + s, y * s + s}.clip(m.interior));
+}
+
+// A pass's picks: level-0 pixels, and coarse ones as (level, index in it), mapped back to level
+// 0 only for the pass that is kept (the first pass often serves only to count).
+struct PassPicks {
+  std::vector<int> pixels;
+  std::vector<std::pair<int, int>> coarse;
+  std::size_t size() const { return pixels.size() + coarse.size(); }
+};
+
+std::vector<int> level0Pixels(const Maps& m, PassPicks pass) {
+  std::vector<int> out = std::move(pass.pixels);
+  out.reserve(out.size() + pass.coarse.size());
+  for (const auto& [k, index] : pass.coarse) out.push_back(toLevel0(m, k, index));
+  return out;
+}
+
+// bestCandidate in the cell of pot x pot pixels at (x, y), clipped to the interior; a cell of one
+// pixel (the first, dense pass) without the rectangle's arithmetic.
+int bestInCell(const CandidateLevel& g0, const Rect& interior, int x, int y, int pot) {
+  if (pot == 1) {
+    const bool inside = x >= interior.x0 && x < interior.x1 && y >= interior.y0 && y < interior.y1;
+    const int index = y * g0.width + x;
+    return inside && g0.value[static_cast<std::size_t>(index)] > 0.f ? index : -1;
+  }
+  const Rect cell = Rect{x, y, x + pot, y + pot}.clip(interior);
+  return cell.empty() ? -1 : bestCandidate(g0, cell);
 }
 
 // One pass over cells of pot x pot pixels, nested as DSO does: a 2pot cell falls back to
 // level 1 only when none of its pot cells found a level-0 pixel, and a 4pot cell falls back to
-// level 2 only when none of its 2pot cells found anything. Returns level-0 pixel indices.
-std::vector<int> selectPass(const Maps& m, int pot) {
+// level 2 only when none of its 2pot cells found anything.
+PassPicks selectPass(const Maps& m, int pot) {
   const CandidateLevel& g0 = m.pyr[0];
-  std::vector<int> picks;
+  PassPicks picks;
   for (int y4 = 0; y4 < g0.height; y4 += 4 * pot) {
     for (int x4 = 0; x4 < g0.width; x4 += 4 * pot) {
       bool found4 = false;
@@ -112,10 +143,9 @@ std::vector<int> selectPass(const Maps& m, int pot) {
           bool found2 = false;
           for (int y1 = y2; y1 < y2 + 2 * pot; y1 += pot) {
             for (int x1 = x2; x1 < x2 + 2 * pot; x1 += pot) {
-              const Rect cell = Rect{x1, y1, x1 + pot, y1 + pot}.clip(m.interior);
-              const int best = cell.empty() ? -1 : bestCandidate(g0, cell);
+              const int best = bestInCell(g0, m.interior, x1, y1, pot);
               if (best >= 0) {
-                picks.push_back(best);
+                picks.pixels.push_back(best);
                 found2 = true;
               }
             }
@@ -123,7 +153,7 @@ std::vector<int> selectPass(const Maps& m, int pot) {
           if (!found2) {
             const int best = bestCoarse(m, 1, {x2, y2, x2 + 2 * pot, y2 + 2 * pot});
             if (best >= 0) {
-              picks.push_back(best);
+              picks.coarse.emplace_back(1, best);
               found2 = true;
             }
           }
@@ -132,7 +162,7 @@ std::vector<int> selectPass(const Maps& m, int pot) {
       }
       if (!found4) {
         const int best = bestCoarse(m, 2, {x4, y4, x4 + 4 * pot, y4 + 4 * pot});
-        if (best >= 0) picks.push_back(best);
+        if (best >= 0) picks.coarse.emplace_back(2, best);
       }
     }
   }
@@ -175,16 +205,17 @@ int initialCellSize(int area, int want) {
 // Gradient selection with the cell size adapted to the target: count ~ K / (pot + 1)^2.
 std::vector<int> adaptiveSelect(const Maps& m, int want, int& pot) {
   pot = initialCellSize(m.gray.cols * m.gray.rows, want);
-  std::vector<int> picks = selectPass(m, pot);
-  const double have = static_cast<double>(picks.size());
+  PassPicks pass = selectPass(m, pot);
+  const double have = static_cast<double>(pass.size());
   const double ratio = have > 0 ? want / have : INFINITY;
   if ((ratio > 1.25 && pot > 1) || ratio < 0.25) {
     const double k = have * (pot + 1) * (pot + 1);
     int ideal = std::max(1, static_cast<int>(std::sqrt(k / want) - 1.0));  // rounded down
     ideal = ratio > 1.25 ? std::min(ideal, pot - 1) : std::max(ideal, pot + 1);
     pot = ideal;
-    picks = selectPass(m, pot);
+    pass = selectPass(m, pot);
   }
+  std::vector<int> picks = level0Pixels(m, std::move(pass));
   thinTo(picks, static_cast<std::size_t>(want));
   return picks;
 }
