@@ -29,6 +29,13 @@ Eigen::Isometry3d trueMotion() {
   return expSE3((Vector6d() << 0.6 * k, -0.5 * k, 0.6 * k, 0.012, -0.01, 0.012).finished());
 }
 
+// A reference's images: a moving cloud's and the whole smoothed grey image.
+DirectImages referenceImages(const LabelledCloud& c) {
+  DirectImages images = directImages(c);
+  addReferenceImages(images, c);
+  return images;
+}
+
 struct Pair {
   LabelledCloud a, b;  // b's points map into a's frame by trueMotion()
 };
@@ -107,9 +114,31 @@ TEST(DirectTerms, WeightedMedianEqualsTheSortedAnswer) {
   }
 }
 
+// A moving cloud's grey values are smoothed at its points' pixels only: the same values as the
+// reference's whole smoothed image there, at the image's corners too (reflected border).
+TEST(DirectTerms, PointGreyValuesAreTheSmoothedImagesAtTheirPixels) {
+  LabelledCloud c = renderedPair(true, false).a;
+  const int w = c.gray.cols, h = c.gray.rows;
+  for (const cv::Point px : {cv::Point(0, 0), cv::Point(w - 1, h - 1), cv::Point(1, h - 2)}) {
+    c.pixels.push_back(px);
+    c.points.push_back(c.points.front());
+    c.labels.push_back(c.labels.front());
+  }
+  const DirectImages ref = referenceImages(c);
+  ASSERT_EQ(ref.point_intensity.size(), c.size());
+  double worst = 0.0;
+  for (std::size_t j = 0; j < c.size(); ++j) {
+    const cv::Point& px = c.pixels[j];
+    worst = std::max(worst, double(std::abs(ref.point_intensity[j] -
+                                            ref.intensity.at<float>(px.y, px.x))));
+  }
+  std::printf("  point grey values against the smoothed image: worst %.2e grey levels\n", worst);
+  EXPECT_LT(worst, 1e-4);  // float rounding of the same sums (measured 3e-5)
+}
+
 TEST(DirectTerms, PhotometricAloneConvergesToTheTrueMotion) {
   const Pair p = renderedPair(true, false);
-  const DirectImages ref = directImages(p.a);
+  const DirectImages ref = referenceImages(p.a);
   const DirectImages mov = directImages(p.b);
   const Error start =
       errorOf(iterate([&](const auto& T) { return photometricAt(ref, mov, p.b, T); }, 0));
@@ -125,7 +154,7 @@ TEST(DirectTerms, PhotometricAloneConvergesToTheTrueMotion) {
 
 TEST(DirectTerms, PointToPlaneAloneConvergesOnExactDepth) {
   const Pair p = renderedPair(false, false);
-  const DirectImages ref = directImages(p.a), mov = directImages(p.b);
+  const DirectImages ref = referenceImages(p.a), mov = directImages(p.b);
   const Error e =
       errorOf(iterate([&](const auto& T) { return pointToPlaneAt(ref, mov, p.b, T, 0.0025); }, 8));
   std::printf("  point to plane: %.4f mm %.5f deg\n", e.mm, e.deg);
@@ -137,7 +166,7 @@ TEST(DirectTerms, PointToPlaneAloneConvergesOnExactDepth) {
 
 TEST(DirectTerms, PointToPlaneFadesOutAsTheDepthNoiseReachesTheModelled) {
   const Pair exact = renderedPair(false, false), noisy = renderedPair(false, true);
-  const DirectImages exact_ref = directImages(exact.a), noisy_ref = directImages(noisy.a);
+  const DirectImages exact_ref = referenceImages(exact.a), noisy_ref = referenceImages(noisy.a);
   const DirectImages exact_b = directImages(exact.b), noisy_b = directImages(noisy.b);
   auto on_exact_depth = [&](double depth_noise) {
     return pointToPlaneAt(exact_ref, exact_b, exact.b, trueMotion(), depth_noise);
@@ -184,7 +213,7 @@ TEST(DirectTerms, PointsOnADepthEdgeOrOccludedAreLeftOut) {
     c.pixels.push_back(px);
     c.points.push_back(c.camera.backProject(px.x, px.y, c.depth.at<float>(px)).cast<float>());
   }
-  const DirectImages ref = directImages(c);
+  const DirectImages ref = referenceImages(c);
   const DirectImages mov = directImages(c);
   // The two points beside the edge are left out, the two inside each surface kept.
   EXPECT_EQ(photometricAt(ref, mov, c, Eigen::Isometry3d::Identity()).used, 2);

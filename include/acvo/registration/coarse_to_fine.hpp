@@ -18,7 +18,7 @@
 namespace acvo {
 
 // A cloud as this engine prepares it: its images for the direct terms (when on), and for a
-// reference one search grid per level.
+// reference one search grid per level and its whole smoothed grey image.
 struct CoarseToFineCloud : PreparedCloud {
   std::vector<VoxelGrid> level_grids;  // one per levelElls, built by prepareReference
   DirectImages images;

@@ -28,21 +28,29 @@ namespace acvo {
 
 // A cloud's images as the terms read them.
 struct DirectImages {
-  cv::Mat intensity;  // CV_32FC1 grey levels, smoothed by a Gaussian of kSmoothing pixels
-  cv::Mat depth;      // CV_32FC1 metres, 0 or NaN = none (the cloud's own)
+  cv::Mat depth;  // CV_32FC1 metres, 0 or NaN = none (the cloud's own)
   Camera camera;
-  // Per point of the cloud: whether its depth is one surface at its pixel's 4 neighbours (a
-  // grey value at a depth edge belongs to either side; a point there is never used).
+  // Per point of the cloud: its grey level smoothed by a Gaussian of kSmoothing pixels, and
+  // whether its depth is one surface at its pixel's 4 neighbours (a grey value at a depth edge
+  // belongs to either side; a point there is never used).
+  std::vector<float> point_intensity;
   std::vector<std::uint8_t> one_surface;
-  bool empty() const { return intensity.empty() || depth.empty(); }
+  // A reference's whole grey image, smoothed likewise (CV_32FC1; addReferenceImages): moving
+  // points are sampled in it.
+  cv::Mat intensity;
+  bool empty() const { return depth.empty(); }
+  bool isReference() const { return !depth.empty() && !intensity.empty(); }
 };
 
 // Smoothing of the grey images (pixels, Gaussian std): rendered images sampled without
 // anti-aliasing give intensity steps no sub-pixel shift can match; a Kinect's are smooth already.
 constexpr double kSmoothing = 0.7;
 
-// From the cloud's grey and depth images (empty when the cloud has none).
+// From the cloud's grey and depth images (empty when the cloud has none): what a moving cloud
+// needs.
 DirectImages directImages(const LabelledCloud& cloud);
+// What a reference needs more: its whole smoothed grey image (none when `images` is empty).
+void addReferenceImages(DirectImages& images, const LabelledCloud& cloud);
 
 // Where a moving point lands in the reference: point j, its position y there and its pixel
 // (u, v). Both terms read the same landings.

@@ -141,6 +141,7 @@ double prepareCoarseToFineReference(CoarseToFineCloud& cloud, const CoarseToFine
   for (double ell : levelElls(p)) {
     cloud.level_grids.emplace_back(cloud.cloud.points, gridCell(ell, p.sigma, p.sparsification));
   }
+  addReferenceImages(cloud.images, cloud.cloud);
   cloud.reference = true;
   const double ms = msSince(t0);
   cloud.ms_prepare += ms;
@@ -181,7 +182,7 @@ SolverResult alignCoarseToFine(const CoarseToFineCloud& fixed, const CoarseToFin
     // refines it (measured: a third fewer iterations, the same accuracy).
     const double eps = p.level_eps * ell / ells.back();
     LevelDirect direct;
-    if (last && directTerms(p) && !fixed.images.empty() && !moving.images.empty()) {
+    if (last && directTerms(p) && fixed.images.isReference() && !moving.images.empty()) {
       direct = {&fixed.images, &moving.images, &moving.cloud};
     }
     if (!iterateLevel(*kernel, direct, ell, eps, last, p, T, result)) {

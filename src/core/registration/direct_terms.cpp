@@ -138,21 +138,52 @@ DirectImages directImages(const LabelledCloud& cloud) {
   if (cloud.gray.empty() || cloud.depth.empty() || cloud.pixels.size() != cloud.size()) {
     return out;
   }
-  cloud.gray.convertTo(out.intensity, CV_32F);
-  cv::GaussianBlur(out.intensity, out.intensity, cv::Size(0, 0), kSmoothing);
   out.depth = cloud.depth;
   out.camera = cloud.camera;
   out.one_surface.resize(cloud.size());
+  out.point_intensity.resize(cloud.size());
+  // The smoothing of addReferenceImages (cv::GaussianBlur's kernel and reflected border, rows
+  // first), at the points' pixels only: most frames are never a reference, and smoothing their
+  // whole image cost more than a tenth of a frame.
+  const int taps = int(std::lround(kSmoothing * 8.0 + 1.0)) | 1, half = taps / 2;
+  const cv::Mat kernel = cv::getGaussianKernel(taps, kSmoothing, CV_32F);
+  const float* k = kernel.ptr<float>();
+  const cv::Mat& g = cloud.gray;
+  auto at = [&](int v, int u) {
+    return float(g.at<std::uint8_t>(cv::borderInterpolate(v, g.rows, cv::BORDER_REFLECT_101),
+                                     cv::borderInterpolate(u, g.cols, cv::BORDER_REFLECT_101)));
+  };
   for (std::size_t j = 0; j < cloud.size(); ++j) {
-    out.one_surface[j] = smoothAround(cloud.depth, cloud.pixels[j], cloud.points[j].z());
+    const cv::Point& p = cloud.pixels[j];
+    out.one_surface[j] = smoothAround(cloud.depth, p, cloud.points[j].z());
+    const bool inside =
+        p.x >= half && p.y >= half && p.x + half < g.cols && p.y + half < g.rows;
+    float sum = 0.0f;
+    for (int dv = -half; dv <= half; ++dv) {
+      float row = 0.0f;
+      if (inside) {
+        const std::uint8_t* r = g.ptr<std::uint8_t>(p.y + dv) + p.x - half;
+        for (int t = 0; t < taps; ++t) row += k[t] * float(r[t]);
+      } else {
+        for (int du = -half; du <= half; ++du) row += k[du + half] * at(p.y + dv, p.x + du);
+      }
+      sum += k[dv + half] * row;
+    }
+    out.point_intensity[j] = sum;
   }
   return out;
+}
+
+void addReferenceImages(DirectImages& images, const LabelledCloud& cloud) {
+  if (images.empty() || !images.intensity.empty() || cloud.gray.empty()) return;
+  cloud.gray.convertTo(images.intensity, CV_32F);
+  cv::GaussianBlur(images.intensity, images.intensity, cv::Size(0, 0), kSmoothing);
 }
 
 std::vector<Landing> landings(const DirectImages& reference, const DirectImages& moving_images,
                               const LabelledCloud& moving, const Eigen::Isometry3d& T) {
   std::vector<Landing> out;
-  if (reference.empty() || moving_images.empty() ||
+  if (!reference.isReference() || moving_images.empty() ||
       moving_images.one_surface.size() != moving.size()) {
     return out;
   }
@@ -177,14 +208,13 @@ std::vector<Landing> landings(const DirectImages& reference, const DirectImages&
 
 DirectSums photometricSums(const DirectImages& reference, const DirectImages& moving_images,
                            const LabelledCloud& moving, const std::vector<Landing>& landed) {
-  if (reference.empty() || moving_images.empty()) return {};
+  if (!reference.isReference() || moving_images.point_intensity.size() != moving.size()) return {};
   const Camera& cam = reference.camera;
   std::vector<Residual> residuals;
   residuals.reserve(landed.size());
   for (const Landing& l : landed) {
-    const cv::Point& px = moving.pixels[l.j];
     const double r = double(bilinear(reference.intensity, l.u, l.v)) -
-                     double(moving_images.intensity.at<float>(px.y, px.x));
+                     double(moving_images.point_intensity[l.j]);
     const Eigen::Vector2d grad = bilinearGradient(reference.intensity, l.u, l.v);
     const double gu = grad.x(), gv = grad.y();
     // d r / d y = [gu gv] d pi / d y; d y / d xi = [-hat(y), I], and (-hat(y))^T d = y x d.
