@@ -67,6 +67,11 @@ const LevelSums& LevelKernel::evaluate(const Eigen::Isometry3d& T, double ell) {
     CandidateLists::Chunk& chunk = lists_.chunk(c);
     // Per-chunk accumulation in double; one point's few terms are summed in float.
     LevelSums s;
+    // This chunk's H from moments of the matched points (see below): sum w a, sum w a y,
+    // sum w a y y^T and sum w a kappa ray ray^T.
+    double m0 = 0.0;
+    Eigen::Vector3d m1 = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d m2 = Eigen::Matrix3d::Zero(), along = Eigen::Matrix3d::Zero();
     int k = 0;
     const int end = std::min(n, (c + 1) * kChunk);
     for (int j = c * kChunk; j < end; ++j) {
@@ -106,17 +111,26 @@ const LevelSums& LevelKernel::evaluate(const Eigen::Isometry3d& T, double ell) {
         ++s.matched;
         // This point's pairs weigh (x_i - y)^T W (x_i - y) by a_ij / ell_j^2,
         // W = I - kappa ray ray^T; they share y, so they enter through sum a and sum a x.
-        const double w = 1.0 / double(s2);
+        // With J = [-hat(y), I] and ray along y (so J^T ray = [0; ray]):
+        // J^T W J = [[|y|^2 I - y y^T, hat(y)], [hat(y)^T, I - kappa ray ray^T]], summed as
+        // moments; J^T W e = [y x W e; W e].
+        const double wa = double(a_sum) / double(s2);
         const Eigen::Vector3d yd = y.cast<double>(), rd = ray.cast<double>();
-        const Eigen::Matrix3d W = Eigen::Matrix3d::Identity() - double(kappa) * rd * rd.transpose();
-        Eigen::Matrix<double, 3, 6> J;
-        J << -hat(yd), Eigen::Matrix3d::Identity();
-        const Eigen::Matrix<double, 6, 3> JtW = J.transpose() * W;
-        s.H += (w * double(a_sum)) * JtW * J;
-        s.g += w * JtW * (x_sum.cast<double>() - double(a_sum) * yd);
+        m0 += wa;
+        m1 += wa * yd;
+        m2.noalias() += (wa * yd) * yd.transpose();
+        along.noalias() += (wa * double(kappa) * rd) * rd.transpose();
+        const Eigen::Vector3d e = (x_sum.cast<double>() - double(a_sum) * yd) / double(s2);
+        const Eigen::Vector3d we = e - double(kappa) * rd * rd.dot(e);
+        s.g.head<3>() += yd.cross(we);
+        s.g.tail<3>() += we;
       }
       s.F += a_sum;
     }
+    s.H.topLeftCorner<3, 3>() = m2.trace() * Eigen::Matrix3d::Identity() - m2;
+    s.H.topRightCorner<3, 3>() = hat(m1);
+    s.H.bottomLeftCorner<3, 3>() = hat(m1).transpose();
+    s.H.bottomRightCorner<3, 3>() = m0 * Eigen::Matrix3d::Identity() - along;
     partial_[std::size_t(c)] = s;
   });
 
