@@ -37,10 +37,13 @@ inline float listRadius(float r) { return 1.3f * r + 0.002f; }
 // or fewer cells).
 float gridCell(double ell, double sigma, double sparsification);
 
-// Colour factor sigma_c^2 exp(-|f - g|^2 / 2 ell_c^2).
+// Colour factor sigma_c^2 exp(-|f - g|^2 / 2 ell_c^2), from the labels or from |f - g|^2.
+inline float colorFactorOf(float label_d2, float color_ell2x2_inv, float color_sigma2) {
+  return color_sigma2 * std::exp(-label_d2 * color_ell2x2_inv);
+}
 inline float colorFactor(const Label& f, const Label& g, float color_ell2x2_inv,
                          float color_sigma2) {
-  return color_sigma2 * std::exp(-(f - g).squaredNorm() * color_ell2x2_inv);
+  return colorFactorOf((f - g).squaredNorm(), color_ell2x2_inv, color_sigma2);
 }
 
 // A search grid over a cloud: square columns of `cell` metres in x and y, each column's points

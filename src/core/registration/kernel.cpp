@@ -184,9 +184,9 @@ void CandidateLists::build(const Eigen::Isometry3d& T, float radius) {
       const float radius2 = rj * rj;
       grid_.forEachWithin(y, rj, [&](int i, const Eigen::Vector3f& x) {
         if (!((x - y).squaredNorm() < radius2)) return;
-        if (!((fx[std::size_t(i)] - gz[std::size_t(j)]).squaredNorm() <= label_d2_max)) return;
-        const float cf = colorFactor(fx[std::size_t(i)], gz[std::size_t(j)], k_.color_inv,
-                                     k_.color_sigma2);
+        const float label_d2 = (fx[std::size_t(i)] - gz[std::size_t(j)]).squaredNorm();
+        if (!(label_d2 <= label_d2_max)) return;
+        const float cf = colorFactorOf(label_d2, k_.color_inv, k_.color_sigma2);
         if (k_.sigma2 * cf < k_.sparsification) return;  // fails at any distance
         chunk.i.push_back(i);
         chunk.color.push_back(cf);
