@@ -15,6 +15,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "../../src/core/cloud/selection_maps.hpp"
 #include "acvo/depth.hpp"
 #include "acvo/point_selector.hpp"
 #include "test_support.hpp"
@@ -211,6 +212,29 @@ TEST(PointSelector, OddSizedViewGivesTheSameAsItsCopy) {
   for (const cv::Point& p : a.pixels) {
     ASSERT_TRUE(p.x >= 4 && p.y >= 4 && p.x < view.cols - 4 && p.y < view.rows - 4) << p;
   }
+}
+
+TEST(PointSelector, DensePassCountEqualsThePassItCounts) {
+  // The selector counts its first pass (cells of one pixel) by rows instead of picking: any
+  // difference would change the cell size of the pass that is kept. Sizes that are no multiple
+  // of the 4x4 cells, smooth and noisy texture, flat halves (coarse fallbacks only).
+  cv::RNG rng(7);
+  std::size_t checked = 0, largest = 0;
+  for (int it = 0; it < 200; ++it) {
+    const int w = rng.uniform(9, 200), h = rng.uniform(9, 160);
+    cv::Mat gray = texturedImage(w, h, std::uint64_t(it) + 1);
+    if (it % 3 == 0) rng.fill(gray, cv::RNG::UNIFORM, 0, 256);
+    if (it % 5 == 0) gray(cv::Rect(0, 0, w / 2, h)).setTo(100);
+    if (it % 7 == 0) gray.setTo(50);
+    const std::size_t counted = selection::densePassCount(gray);
+    ASSERT_EQ(counted, selection::passSize(gray, 1)) << w << "x" << h << ", image " << it;
+    largest = std::max(largest, counted);
+    ++checked;
+  }
+  const cv::Mat big = texturedImage(640, 480, 3);
+  EXPECT_EQ(selection::densePassCount(big), selection::passSize(big, 1));
+  EXPECT_GT(largest, 1000u);  // the images had candidates to count
+  EXPECT_EQ(checked, 200u);
 }
 
 TEST(PointSelector, BlankImageSelectsNothing) {

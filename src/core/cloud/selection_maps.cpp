@@ -63,13 +63,49 @@ struct BlockThresholds {
   float at(int bx, int by) const { return th[static_cast<std::size_t>(by) * blocks_x + bx]; }
 };
 
+// histogramBin(m) = binOfQuarters(floor(4 m)) for every m >= 0 (k^2 <= m if and only if
+// 4 k^2 <= floor(4 m)), by table up to the last bin's 4 * 48^2. Level-0 values are quarters of
+// integers anyway (central differences of 8-bit values).
+constexpr int kLastQuarters = 4 * kHistMax * kHistMax;
+const std::array<std::uint8_t, kLastQuarters + 1>& binOfQuarters() {
+  static const auto table = [] {
+    std::array<std::uint8_t, kLastQuarters + 1> t{};
+    for (int q = 0; q <= kLastQuarters; ++q) {
+      t[static_cast<std::size_t>(q)] = static_cast<std::uint8_t>(histogramBin(0.25f * q));
+    }
+    return t;
+  }();
+  return table;
+}
+
 BlockThresholds blockThresholds(const CandidateLevel& mag2) {
   const int bx = (mag2.width + kBlock - 1) / kBlock, by = (mag2.height + kBlock - 1) / kBlock;
   std::vector<Histogram> hist(static_cast<std::size_t>(bx) * by, Histogram{});
-  for (int v = 1; v + 1 < mag2.height; ++v) {
-    Histogram* row_hist = &hist[static_cast<std::size_t>(v / kBlock) * bx];
-    const float* row = &mag2.value[static_cast<std::size_t>(v) * mag2.width];
-    for (int u = 1; u + 1 < mag2.width; ++u) ++row_hist[u / kBlock][histogramBin(row[u])];
+  // Per block row, four histograms per block that take the pixels in turn: neighbouring pixels
+  // mostly fall in the same bin, and with one histogram each increment waited on the one before
+  // (two thirds of the candidate maps' time went to that chain).
+  const auto& bin_of = binOfQuarters();
+  std::vector<std::array<Histogram, 4>> lanes(static_cast<std::size_t>(bx));
+  std::vector<int> quarters(static_cast<std::size_t>(mag2.width), 0);
+  for (int b = 0; b < by; ++b) {
+    for (auto& l : lanes) l.fill(Histogram{});
+    const int v_end = std::min((b + 1) * kBlock, mag2.height - 1);
+    for (int v = std::max(b * kBlock, 1); v < v_end; ++v) {
+      const float* row = &mag2.value[static_cast<std::size_t>(v) * mag2.width];
+      for (int u = 1; u + 1 < mag2.width; ++u) {
+        quarters[std::size_t(u)] = std::min(static_cast<int>(4.f * row[u]), kLastQuarters);
+      }
+      for (int u = 1; u + 1 < mag2.width; ++u) {
+        ++lanes[std::size_t(u / kBlock)][std::size_t(u & 3)]
+               [bin_of[std::size_t(quarters[std::size_t(u)])]];
+      }
+    }
+    for (int x = 0; x < bx; ++x) {
+      Histogram& h = hist[static_cast<std::size_t>(b) * bx + x];
+      for (const Histogram& l : lanes[std::size_t(x)]) {
+        for (std::size_t k = 0; k < h.size(); ++k) h[k] += l[k];
+      }
+    }
   }
   std::vector<float> median(hist.size());
   for (std::size_t b = 0; b < hist.size(); ++b) {

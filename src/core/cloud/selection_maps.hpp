@@ -1,6 +1,6 @@
 // The candidate maps of the DSO-style selector (docs/method.md §1): for each level of a 3-level
 // pyramid, |grad I|^2 where it exceeds that level's share of the local threshold, 0 elsewhere.
-// Internal to point_selector.cpp.
+// Internal to point_selector.cpp (and its tests).
 #pragma once
 
 #include <array>
@@ -25,6 +25,12 @@ using CandidatePyramid = std::array<CandidateLevel, 3>;
 // level 2 0.75 * 0.5625. Gradients are central differences of each level; the outermost pixels
 // of each level have none (value 0).
 CandidatePyramid candidateMaps(const cv::Mat& gray);
+
+// Picks of the selector's pass with cells of `pot` pixels over `gray` (point_selector.cpp), and
+// their number for cells of one pixel counted by rows, as the selector counts its first pass:
+// equal by construction, and tested to be.
+std::size_t passSize(const cv::Mat& gray, int pot);
+std::size_t densePassCount(const cv::Mat& gray);
 
 // Level-0 |grad I|^2 at an inner pixel (1 <= u < cols - 1, 1 <= v < rows - 1).
 float gradientMag2(const cv::Mat& gray, int u, int v);
