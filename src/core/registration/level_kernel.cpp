@@ -59,7 +59,6 @@ const LevelSums& LevelKernel::evaluate(const Eigen::Isometry3d& T, double ell) {
   const float r2_unit = r * r;
   const float inv_unit = float(1.0 / (2.0 * ell * ell));
   const float sigma2 = k_.sigma2, sp = k_.sparsification;
-  const auto& X = fixed_.points;
   const auto& Z = moving_.points;
   const int n = int(Z.size());
 
@@ -101,7 +100,7 @@ const LevelSums& LevelKernel::evaluate(const Eigen::Isometry3d& T, double ell) {
         for (int q = 0; q < m; ++q) {
           if (!(d2[q] < r2) || a[q] < sp) continue;
           const float aq = a[q];
-          x_sum += aq * X[std::size_t(chunk.i[std::size_t(k) + std::size_t(q)])];
+          x_sum += aq * Eigen::Vector3f(cx[q], cy[q], cz[q]);
           a_sum += aq;
           ++s.nnz;
         }
