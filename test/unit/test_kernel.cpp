@@ -60,6 +60,27 @@ TEST(VoxelGrid, CandidatesContainEveryPointWithinTheRadius) {
   }
 }
 
+TEST(VoxelGrid, FewPointsSpreadFarMakeAFewColumns) {
+  // 300 points over 2 km (as absurd intrinsics give): a 1 cm grid would need 4e10 columns; the
+  // cells grow until the points' share of columns is left, and every point is still found.
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> across(-1000.f, 1000.f);
+  std::vector<Eigen::Vector3f> points;
+  for (int k = 0; k < 300; ++k) points.emplace_back(across(rng), across(rng), 2.f);
+  const VoxelGrid grid(points, 0.01f);
+  EXPECT_LE(grid.columns(), VoxelGrid::maxColumns(points.size()));
+  EXPECT_GT(grid.columns(), VoxelGrid::maxColumns(points.size()) / 1.5 / 1.5);  // not coarser
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    bool found = false;
+    grid.forEachWithin(points[i], 0.01f,
+                       [&](int j, const Eigen::Vector3f&) { found |= j == int(i); });
+    ASSERT_TRUE(found) << "point " << i;
+  }
+  // A camera's cloud keeps its cells: 2000 points within a metre at 9 cm.
+  const LabelledCloud c = test::randomCloud(2000, 7, 0.5f);
+  EXPECT_EQ(VoxelGrid(c.points, 0.09f).cell(), 0.09f);
+}
+
 TEST(PaperKernel, EqualsBruteForceOnRandomClouds) {
   const PaperParams p = paperParams().paper;
   const LabelledCloud X = test::randomCloud(1500, 1, 0.5f);

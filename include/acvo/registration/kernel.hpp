@@ -58,6 +58,14 @@ class VoxelGrid {
 
   float cell() const { return cell_; }
   bool empty() const { return order_.empty(); }
+  int columns() const { return nx_ * ny_; }
+  // The most columns a grid over `points` finite points has: beyond it the cells are coarsened.
+  // Camera clouds use up to 10 columns per point (teddy200 to 10 m; 1-2 in rooms); a few hundred
+  // points from absurd intrinsics made grids of 4 million mostly empty columns, each built and
+  // zeroed again at every level.
+  static double maxColumns(std::size_t points) {
+    return std::min(4e6, 4096.0 + 32.0 * double(points));
+  }
   // Calls f(index, point) for every point in the box of half-width `radius` around q, so for
   // every point within `radius` of q (and a few more from the columns' corners).
   template <typename F>

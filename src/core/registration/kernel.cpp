@@ -51,19 +51,21 @@ VoxelGrid::VoxelGrid(const std::vector<Eigen::Vector3f>& points, float cell) : c
   const auto first = std::find_if(points.begin(), points.end(), finite);
   if (first == points.end()) return;
   Eigen::Vector2f lo = first->head<2>(), hi = first->head<2>();
+  std::size_t finite_points = 0;
   for (const auto& p : points) {
     if (!finite(p)) continue;
     lo = lo.cwiseMin(p.head<2>());
     hi = hi.cwiseMax(p.head<2>());
+    ++finite_points;
   }
-  // A cloud spread far beyond the radius would make a huge dense grid: coarsen the cells then
-  // (candidates stay a superset of the true neighbours, searches only get slower). The extent is
-  // taken in double: hi - lo of finite floats may overflow float.
-  constexpr double kMaxColumns = 4e6;
+  // A cloud spread far beyond the radius would make a huge grid of empty columns: coarsen the
+  // cells then (candidates stay a superset of the true neighbours, searches only get slower).
+  // The extent is taken in double: hi - lo of finite floats may overflow float.
+  const double max_columns = maxColumns(finite_points);
   const Eigen::Vector2d extent = hi.cast<double>() - lo.cast<double>();
   for (;;) {
     const Eigen::Vector2d n = (extent / double(cell_)).array().floor() + 1.0;
-    if (n.x() * n.y() <= kMaxColumns) {
+    if (n.x() * n.y() <= max_columns) {
       nx_ = int(n.x()), ny_ = int(n.y());
       break;
     }
