@@ -63,7 +63,6 @@ class LevelKernel {
  private:
   void shapeFor(double ell);  // the per-point kernel shapes at `ell`
 
-  const LabelledCloud& fixed_;
   const LabelledCloud& moving_;
   CoarseToFineParams params_;
   KernelConstants k_;

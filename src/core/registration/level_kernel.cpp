@@ -21,8 +21,7 @@ bool perPointKernel(const CoarseToFineParams& p) {
 
 LevelKernel::LevelKernel(const LabelledCloud& fixed, const LabelledCloud& moving,
                          const VoxelGrid& grid, const CoarseToFineParams& params)
-    : fixed_(fixed),
-      moving_(moving),
+    : moving_(moving),
       params_(params),
       k_(kernelConstants(params.sigma, params.color_ell, params.color_sigma,
                          params.sparsification)),
