@@ -80,21 +80,25 @@ struct Maps {
   Rect interior;
 };
 
-// Best candidate of level k (scale s = 2^k) whose level-0 footprint meets the interior, inside
-// the level-0 rectangle `cell` (its corners are multiples of s): its index in level k, -1 when
-// there is none.
-int bestCoarse(const Maps& m, int k, const Rect& cell) {
+// The pixels of level k (scale s = 2^k) whose level-0 footprint meets the interior: coarse
+// pixel x covers level-0 columns [x s, x s + s), so it meets the interior when x >= x0 / s and
+// x s < x1. (Shifts: the coordinates are not negative, and a division by a variable s made this
+// the costliest part of a pass.)
+Rect coarseInterior(const Maps& m, int k) {
   const CandidateLevel& level = m.pyr[k];
   const int s = 1 << k;
   const Rect& in = m.interior;
-  // Coarse pixel x covers level-0 columns [x s, x s + s): it meets the interior when
-  // x >= x0 / s and x s < x1. (Shifts: the coordinates are not negative, and a division by a
-  // variable s made this the costliest part of a pass.)
+  return Rect{in.x0 >> k, in.y0 >> k, (in.x1 + s - 1) >> k, (in.y1 + s - 1) >> k}.clip(
+      {0, 0, level.width, level.height});
+}
+
+// Best candidate of level k whose level-0 footprint meets the interior, inside the level-0
+// rectangle `cell` (its corners are multiples of 2^k): its index in level k, -1 when there is
+// none.
+int bestCoarse(const Maps& m, int k, const Rect& cell) {
   const Rect coarse =
-      Rect{cell.x0 >> k, cell.y0 >> k, cell.x1 >> k, cell.y1 >> k}
-          .clip({in.x0 >> k, in.y0 >> k, (in.x1 + s - 1) >> k, (in.y1 + s - 1) >> k})
-          .clip({0, 0, level.width, level.height});
-  return coarse.empty() ? -1 : bestCandidate(level, coarse);
+      Rect{cell.x0 >> k, cell.y0 >> k, cell.x1 >> k, cell.y1 >> k}.clip(coarseInterior(m, k));
+  return coarse.empty() ? -1 : bestCandidate(m.pyr[k], coarse);
 }
 
 // A coarse pick mapped back to the level-0 pixel of its footprint with the largest gradient.
@@ -177,17 +181,13 @@ PassPicks selectPass(const Maps& m, int pot) {
 // nested cells (callgrind over 20 teddy200 frames: the pass took a quarter of a frame's
 // instructions). Level 0: the interior's candidates; level 1: a 2x2 cell's coarse pixel when
 // none of its level-0 pixels is a candidate; level 2: a 4x4 cell's when none of its 2x2 cells
-// took anything. A coarse pixel counts where bestCoarse would read it (the interior's footprint
-// at that level, clipped to the level).
+// took anything. A coarse pixel counts where bestCoarse would read it (coarseInterior).
 std::size_t countDensePass(const Maps& m) {
   const CandidateLevel& g0 = m.pyr[0];
   const CandidateLevel& g1 = m.pyr[1];
   const CandidateLevel& g2 = m.pyr[2];
   const Rect& in = m.interior;
-  const Rect in1 = Rect{in.x0 >> 1, in.y0 >> 1, (in.x1 + 1) >> 1, (in.y1 + 1) >> 1}.clip(
-      {0, 0, g1.width, g1.height});
-  const Rect in2 = Rect{in.x0 >> 2, in.y0 >> 2, (in.x1 + 3) >> 2, (in.y1 + 3) >> 2}.clip(
-      {0, 0, g2.width, g2.height});
+  const Rect in1 = coarseInterior(m, 1), in2 = coarseInterior(m, 2);
   // The pass's 4x4 cells cover the image rounded up to multiples of 4: 2x2 cells per row and
   // column of that.
   const int cw = (g0.width + 3) / 4 * 2, ch = (g0.height + 3) / 4 * 2;
@@ -312,19 +312,22 @@ std::vector<int> cannyPixels(const cv::Mat& gray, const Rect& interior,
   return added;
 }
 
+// Pixels this far from every edge are never selected.
+Rect interiorOf(const cv::Mat& gray) {
+  return {kBorder, kBorder, gray.cols - kBorder, gray.rows - kBorder};
+}
+
 }  // namespace
 
 namespace selection {
 std::size_t passSize(const cv::Mat& gray, int pot) {
-  const Rect interior{kBorder, kBorder, gray.cols - kBorder, gray.rows - kBorder};
   const CandidatePyramid pyr = candidateMaps(gray);
-  return selectPass({gray, pyr, interior}, pot).size();
+  return selectPass({gray, pyr, interiorOf(gray)}, pot).size();
 }
 
 std::size_t densePassCount(const cv::Mat& gray) {
-  const Rect interior{kBorder, kBorder, gray.cols - kBorder, gray.rows - kBorder};
   const CandidatePyramid pyr = candidateMaps(gray);
-  return countDensePass({gray, pyr, interior});
+  return countDensePass({gray, pyr, interiorOf(gray)});
 }
 }  // namespace selection
 
@@ -334,7 +337,7 @@ Selection selectPixels(const cv::Mat& gray, const cv::Mat& depth, const Selectio
     throw std::invalid_argument("selectPixels: depth must be 32FC1 and the size of the image");
   }
   Selection out;
-  const Rect interior{kBorder, kBorder, gray.cols - kBorder, gray.rows - kBorder};
+  const Rect interior = interiorOf(gray);
   if (interior.empty() || params.target_points <= 0) return out;
 
   const CandidatePyramid pyr = selection::candidateMaps(gray);
