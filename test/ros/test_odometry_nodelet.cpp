@@ -1283,10 +1283,13 @@ TEST(OdometryNodelet, AFasterCameraIsDroppedNotQueued) {
   std::sort(alone_total.begin(), alone_total.end());
   const double typical = alone_total[alone_total.size() / 2];
   const double slowest = alone_total.back();
-  // The stream: kFrames frames at a quarter of the time one typically takes (a load spike
-  // during the frames alone must not make the camera slower than the odometry).
+  // The stream: kFrames frames at a sixth of the time one typically takes alone (a load spike
+  // during the frames alone must not make the camera slower than the odometry). A frame of the
+  // stream costs less than one alone (no keyframe at every frame): at a quarter, 11-14 of 30
+  // were processed once the selection and the kernel pass got cheaper (four runs, 2026-11-26),
+  // and the camera was no longer four times faster than the odometry.
   constexpr int kFrames = 30;
-  const double period = typical / 4000.0;  // s
+  const double period = typical / 6000.0;  // s
   std::vector<ros::Time> stamps;
   std::vector<Client::Messages> stream;
   for (int i = 0; i < kFrames; ++i) client->frame(6 + i);  // rendered ahead
@@ -1314,8 +1317,9 @@ TEST(OdometryNodelet, AFasterCameraIsDroppedNotQueued) {
             << " ms): " << latency.size() << " processed; latency first " << latency.front()
             << " ms, last " << latency.back() << " ms, worst " << worst << " ms\n";
   // A backlog processes every frame it holds, each later than the one before. Measured: with
-  // the queues of 2, 9 of 30 processed, worst latency 110-123 ms (three runs); with 10 per
-  // topic (as before) 16-21 processed and 455-475 ms.
+  // the queues of 2, 9 of 30 processed, worst latency 110-123 ms (three runs, the camera at a
+  // quarter); with 10 per topic (as before) 16-21 processed and 455-475 ms. At a sixth
+  // (2026-11-26, five runs): 8 of 30, worst 58-88 ms.
   EXPECT_LE(latency.size(), std::size_t{kFrames * 2 / 5});
   EXPECT_LT(worst, kQueuedFrames * slowest + kLatencySlack);
   EXPECT_TRUE(isTracking(last.info->tracking)) << last.info->message;
