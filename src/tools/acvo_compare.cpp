@@ -46,6 +46,8 @@ frame registered to the previous one, no initial guess), once per --peer-max-dep
 relative to the settings' mean). Every method sees the same decoded frames, frame by frame in
 turn; times cover the odometry call only (acvo: cloud building and registration; OpenCV: grey
 conversion, hole marking, pyramids and registration).
+--stride K keeps every K-th frame: the same camera moving K times faster between frames, the
+way to see how wide each method's basin is (the dataset is then named <folder>_everyK).
 )";
 
 constexpr const char* kFooter = "Exit status: 0 success, 2 bad arguments or input.";
@@ -55,7 +57,7 @@ struct Options {
   std::vector<double> peer_max_depth{4.0, 10.0};
   std::vector<int> threads{1};
   std::string config, label = "acvo", json, trajectories;
-  long frames = -1;
+  long frames = -1, stride = 1;
   int repeat = 1;
   bool peer_guess = false;
 };
@@ -105,6 +107,11 @@ std::optional<int> parseOptions(CLI::App& app, Options& o, int argc, char** argv
       ->type_name("N")
       ->check(
           acvo::tools::numberIn(0L, std::numeric_limits<long>::max(), "a non-negative integer"));
+  app.add_option("--stride", o.stride,
+                 "use every K-th frame (a camera K times faster); --frames counts the frames used")
+      ->type_name("K")
+      ->capture_default_str()
+      ->check(acvo::tools::numberIn(1L, 1000000L, "within [1, 1000000]"));
   app.add_option("--json", o.json, "write every figure as JSON")->type_name("FILE");
   app.add_option("--trajectories", o.trajectories,
                  "write each estimate as DIR/<dataset>-<method>[-<setting>].txt")
@@ -241,7 +248,7 @@ double processCpuMs() {
 // One run over the frames: every frame to every method in turn, the first method of each frame
 // rotating. The first run also records the trajectories.
 void runOnce(std::vector<Entry>& entries, const std::vector<acvo::Frame>& frames,
-             const acvo::TumDataset& data, bool record) {
+             const std::vector<std::size_t>& index, const acvo::TumDataset& data, bool record) {
   const std::size_t m = entries.size();
   std::vector<std::unique_ptr<Method>> methods;
   for (auto& e : entries) methods.push_back(e.make());
@@ -262,7 +269,7 @@ void runOnce(std::vector<Entry>& entries, const std::vector<acvo::Frame>& frames
       if (!record) continue;
       Row& row = entries[j].row;
       if (!ok && i > 0) ++row.lost;
-      const auto& stamp = data.frames()[i].rgb;
+      const auto& stamp = data.frames()[index[i]].rgb;
       row.trajectory.push_back({stamp.stamp_text, stamp.stamp, methods[j]->pose()});
     }
   }
@@ -399,16 +406,21 @@ int main(int argc, char** argv) {
     std::vector<Row> rows;
     for (const auto& folder : opt.datasets) {
       const acvo::TumDataset data(folder);
-      const std::size_t n =
-          opt.frames < 0 ? data.size() : std::min(data.size(), std::size_t(opt.frames));
+      // The dataset's frames used: every stride-th, at most --frames of them.
+      std::vector<std::size_t> index;
+      for (std::size_t i = 0; i < data.size(); i += std::size_t(opt.stride)) {
+        if (opt.frames >= 0 && index.size() >= std::size_t(opt.frames)) break;
+        index.push_back(i);
+      }
       std::vector<acvo::Frame> frames;
-      frames.reserve(n);
-      for (std::size_t i = 0; i < n; ++i) frames.push_back(data.loadFrame(i));
+      frames.reserve(index.size());
+      for (const std::size_t i : index) frames.push_back(data.loadFrame(i));
       if (frames.empty()) throw std::runtime_error(folder + ": no frames");
-      const std::string dataset = baseName(folder);
+      const std::string dataset =
+          baseName(folder) + (opt.stride > 1 ? "_every" + std::to_string(opt.stride) : "");
       std::vector<Entry> entries =
           entriesFor(opt, params, data, dataset, startPose(data, frames.front().stamp));
-      for (int run = 0; run < opt.repeat; ++run) runOnce(entries, frames, data, run == 0);
+      for (int run = 0; run < opt.repeat; ++run) runOnce(entries, frames, index, data, run == 0);
       for (auto& e : entries) evaluate(e.row, data);
 
       // The best setting of each peer, and the speed ratio to the best RgbdOdometry, per run.

@@ -161,6 +161,33 @@ TEST_F(CompareTool, ASubsetOfMethodsAndItsLabel) {
   EXPECT_EQ(rows[1][10], "nan");  // no RgbdOdometry row to compare the speed with
 }
 
+// --stride 3 uses frames 0, 3, 6, ...: the trajectory has their stamps (--frames counts the
+// frames used), and the dataset is named for the stride.
+TEST_F(CompareTool, StrideUsesEveryKthFrame) {
+  const fs::path out = dir_ / "stride.txt", traj = dir_ / "traj_stride";
+  fs::create_directories(traj);
+  ASSERT_EQ(runTool("acvo_compare",
+                    "'" + (dir_ / "room").string() +
+                        "' --methods acvo --stride 3 --frames 10 --trajectories '" +
+                        traj.string() + "'",
+                    out),
+            0);
+  const auto rows = words(out);
+  ASSERT_EQ(rows.size(), 2u) << readText(out);
+  EXPECT_EQ(rows[1][0], "room_every3");
+  EXPECT_EQ(rows[1][6], "0");  // lost frames: a tenth of a second apart is well within the basin
+  const auto poses = words(traj / "room_every3-acvo.txt");
+  const auto stamps = words(dir_ / "room" / "rgb.txt");
+  std::vector<std::string> expected;
+  for (const auto& line : stamps) {
+    if (!line.empty() && line[0][0] != '#') expected.push_back(line[0]);
+  }
+  ASSERT_EQ(poses.size(), 10u);
+  ASSERT_GE(expected.size(), 28u);
+  for (std::size_t i = 0; i < poses.size(); ++i) EXPECT_EQ(poses[i][0], expected[3 * i]) << i;
+  EXPECT_EQ(runTool("acvo_compare", "'" + (dir_ / "room").string() + "' --stride 0", out), 2);
+}
+
 TEST_F(CompareTool, BadArgumentsExitWithStatusTwo) {
   const fs::path out = dir_ / "bad.txt";
   const std::string room = "'" + (dir_ / "room").string() + "'";
