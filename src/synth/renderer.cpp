@@ -96,7 +96,28 @@ std::vector<PixelRect> primitiveBounds(const Scene& scene, const Camera& camera,
   return bounds;
 }
 
+// The colour seen from the colour camera at the depth camera's `pose` (the exact colour of
+// `exact` when the two are one camera).
+cv::Mat colourAt(const Scene& scene, const Eigen::Isometry3d& pose, const RenderOptions& options,
+                 const RayCast* exact) {
+  if (options.colourRegistered()) {
+    return exact ? exact->colour : rayCast(scene, options.camera, pose).colour;
+  }
+  return rayCast(scene, options.colourCamera(), options.colourPose(pose)).colour;
+}
+
 }  // namespace
+
+Camera RenderOptions::colourCamera() const {
+  Camera c = camera;
+  c.fx *= colour_focal_ratio;
+  c.fy *= colour_focal_ratio;
+  return c;
+}
+
+Eigen::Isometry3d RenderOptions::colourPose(const Eigen::Isometry3d& pose) const {
+  return pose * Eigen::Translation3d(colour_baseline, 0.0, 0.0);
+}
 
 Frame SynthFrame::toFrame() const {
   Frame f;
@@ -158,7 +179,7 @@ RayCast rayCast(const Scene& scene, const Camera& camera, const Eigen::Isometry3
 SynthFrame render(const Scene& scene, const Eigen::Isometry3d& pose, const RenderOptions& options,
                   std::uint64_t seed) {
   const RayCast exact = rayCast(scene, options.camera, pose);
-  return finish(pose, options, seed, exact, exact.colour);
+  return finish(pose, options, seed, exact, colourAt(scene, pose, options, &exact));
 }
 
 SynthFrame renderBlurred(const Scene& scene, const Eigen::Isometry3d& pose,
@@ -170,7 +191,7 @@ SynthFrame renderBlurred(const Scene& scene, const Eigen::Isometry3d& pose,
   for (const Eigen::Isometry3d& sub_pose : exposure) {
     // The middle of an odd number of sub-frames is usually the frame's own pose.
     const bool same = sub_pose.matrix() == pose.matrix();
-    sum += same ? exact.colour : rayCast(scene, options.camera, sub_pose).colour;
+    sum += colourAt(scene, sub_pose, options, same ? &exact : nullptr);
   }
   cv::Mat colour = sum / static_cast<double>(exposure.size());
   return finish(pose, options, seed, exact, colour);

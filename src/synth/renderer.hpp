@@ -27,6 +27,17 @@ struct RenderOptions {
   Camera camera;       // intrinsics and size; depth_scale sets the noisy depth's unit
   bool noise = false;  // Kinect-like degradations (kinect_noise.hpp) of depth and colour
   KinectNoise kinect;  // their parameters
+  // An unregistered colour camera (7-Scenes' colour and depth come from the Kinect's two
+  // cameras, paired pixel by pixel as if they were one): its focal lengths are
+  // colour_focal_ratio times `camera`'s about the same principal point, its centre
+  // colour_baseline metres along the depth camera's x axis, its axes parallel. The colour
+  // image is the colour camera's; depth, surfaces and the pose stay the depth camera's.
+  double colour_focal_ratio = 1.0;
+  double colour_baseline = 0.0;  // m
+
+  bool colourRegistered() const { return colour_focal_ratio == 1.0 && colour_baseline == 0.0; }
+  Camera colourCamera() const;                                        // intrinsics
+  Eigen::Isometry3d colourPose(const Eigen::Isometry3d& pose) const;  // camera-to-world
 };
 
 struct SynthFrame {

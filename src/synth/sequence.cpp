@@ -25,6 +25,10 @@ const SequenceOptions& validated(const SequenceOptions& o) {
   if (o.blur_samples < 1) throw std::invalid_argument("blur_samples must be at least 1");
   if (!(o.exposure >= 0 && o.exposure <= 1))
     throw std::invalid_argument("exposure must be within [0, 1]");
+  if (!(o.colour_focal_ratio >= 0.5 && o.colour_focal_ratio <= 2))
+    throw std::invalid_argument("colour_focal_ratio must be within [0.5, 2]");
+  if (!(std::abs(o.colour_baseline) <= 1))
+    throw std::invalid_argument("colour_baseline must be within [-1, 1] m");
   return o;
 }
 
@@ -35,6 +39,10 @@ std::string describe(const SequenceOptions& o) {
     << (o.structure ? "on" : "off") << ", texture " << (o.texture ? "on" : "off") << ", noise "
     << (o.noise ? "on" : "off") << ", blur " << (o.blur ? "on" : "off") << ", " << o.camera.width
     << "x" << o.camera.height;
+  if (o.colour_focal_ratio != 1.0 || o.colour_baseline != 0.0) {
+    s << ", colour unregistered: focal x" << o.colour_focal_ratio << ", baseline "
+      << o.colour_baseline << " m";
+  }
   return s.str();
 }
 
@@ -64,6 +72,8 @@ RenderOptions SequenceOptions::renderOptions() const {
   RenderOptions r;
   r.camera = camera;
   r.noise = noise;
+  r.colour_focal_ratio = colour_focal_ratio;
+  r.colour_baseline = colour_baseline;
   return r;
 }
 

@@ -35,6 +35,8 @@ struct SequenceOptions {
   bool blur = false;
   int blur_samples = 5;         // sub-frame renders averaged per blurred frame
   double exposure = 0.5;        // shutter time as a fraction of the frame interval (blur)
+  double colour_focal_ratio = 1.0;  // an unregistered colour camera (RenderOptions)
+  double colour_baseline = 0.0;     // m
   Camera camera;                // TUM default intrinsics, 640x480, depth scale 5000
   double first_stamp = 1000.0;  // seconds; frame i is at first_stamp + i / rate
 
@@ -50,7 +52,8 @@ Camera scaledDefaultCamera(int width, int height);
 class SynthSequence {
  public:
   // Throws std::invalid_argument for bad options (frames < 0, rate <= 0, speed < 0,
-  // invalid camera, blur_samples < 1, exposure outside [0, 1]).
+  // invalid camera, blur_samples < 1, exposure outside [0, 1], colour_focal_ratio outside
+  // [0.5, 2], colour_baseline not within 1 m).
   explicit SynthSequence(const SequenceOptions& options);
 
   int size() const { return options_.frames; }

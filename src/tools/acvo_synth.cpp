@@ -72,6 +72,18 @@ int main(int argc, char** argv) {
   addSwitch(app, "--noise", o.noise,
             "Kinect-like depth noise, quantisation, dropouts; colour noise");
   addSwitch(app, "--blur", o.blur, "motion blur (mean of sub-frame renders over half a frame)");
+  app.add_option("--colour-focal-ratio", o.colour_focal_ratio,
+                 "an unregistered colour camera: its focal length over the depth camera's "
+                 "(7-Scenes: about 525/585)")
+      ->type_name("R")
+      ->capture_default_str()
+      ->transform(acvo::tools::numberIn(0.5, 2.0, "within [0.5, 2]"));
+  app.add_option("--colour-baseline", o.colour_baseline,
+                 "an unregistered colour camera: its offset along x from the depth camera "
+                 "(a Kinect's: 0.025 m)")
+      ->type_name("M")
+      ->capture_default_str()
+      ->transform(acvo::tools::numberIn(-1.0, 1.0, "within [-1, 1] m"));
   const auto size = acvo::tools::numberIn(8, 8192, "within [8, 8192] pixels");
   app.add_option("--width", width, "image width; the 640x480 intrinsics scale with the size")
       ->type_name("W")

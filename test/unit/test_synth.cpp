@@ -1,9 +1,11 @@
 // Synthetic scenes and rendering: exact geometry, determinism, the scene variants, the
-// Kinect-like degradations and motion blur.
+// Kinect-like degradations, motion blur and an unregistered colour camera.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
 
 #include <Eigen/SVD>
 #include <opencv2/imgproc.hpp>
@@ -116,6 +118,69 @@ TEST(SynthRender, PixelCentresAndOpticalAxes) {
   EXPECT_NEAR(f.depth_m.at<float>(240, 420), 1.0, 1e-6);  // 45 degrees right
   EXPECT_LT((world(420, 240) - Eigen::Vector3d(1, kSinglePlaneY, 1)).norm(), 1e-6);
   EXPECT_LT((world(320, 340) - Eigen::Vector3d(0, kSinglePlaneY, 0)).norm(), 1e-6);  // down
+}
+
+// An unregistered colour camera. Its image is the one a camera with its intrinsics at its
+// place renders; depth, surfaces and the pose stay the depth camera's. Where it looks, in the
+// flat-coloured room (colour changes only where the surface does): at half the focal length,
+// colour pixel c + k sees what pixel c + 2k of the registered image sees; 1 m from the single
+// plane, 0.1 m along x at fx 100, colour pixel u sees the point pixel u + 10 sees (the same
+// texture, filtered for the colour camera's own pixel footprint).
+TEST(SynthRender, AnUnregisteredColourCameraSeesFromItsOwnPlace) {
+  RenderOptions registered;
+  registered.camera.fx = registered.camera.fy = 100.0;
+  registered.camera.cx = 320.0;
+  registered.camera.cy = 240.0;
+  struct Case {
+    Scene scene;
+    Eigen::Isometry3d pose;
+    double ratio, baseline;
+    int du, scale;  // where colour pixel (u, v) looks in the registered image
+  };
+  const Case cases[] = {
+      {makeScene({true, false, 3}), somePose(40, 3), 0.5, 0.0, 0, 2},
+      {makeScene({false, true, 1}),
+       lookAt({0, kSinglePlaneY - 1.0, 1}, {0, kSinglePlaneY, 1}), 1.0, 0.1, 10, 1}};
+  for (const Case& c : cases) {
+    const SynthFrame reference = render(c.scene, c.pose, registered);
+    const cv::Mat ref = grey(reference.bgr);
+    RenderOptions colour = registered;
+    colour.colour_focal_ratio = c.ratio;
+    colour.colour_baseline = c.baseline;
+    ASSERT_FALSE(colour.colourRegistered());
+    const SynthFrame f = render(c.scene, c.pose, colour);
+    EXPECT_EQ(cv::norm(f.depth_m, reference.depth_m, cv::NORM_INF), 0.0);
+    EXPECT_EQ(cv::countNonZero(f.surface != reference.surface), 0);
+    EXPECT_TRUE(f.pose.isApprox(c.pose));
+    RenderOptions there = registered;
+    there.camera = colour.colourCamera();
+    const SynthFrame seen = render(c.scene, colour.colourPose(c.pose), there);
+    EXPECT_EQ(cv::norm(f.bgr, seen.bgr, cv::NORM_INF), 0.0);
+    EXPECT_LT(((c.pose.inverse() * colour.colourPose(c.pose)).translation() -
+               Eigen::Vector3d(c.baseline, 0, 0))
+                  .norm(),
+              1e-12);
+
+    // Mean absolute grey difference of the colour image against the registered one, unmoved
+    // and where each pixel looks, over the pixels that look inside the image.
+    const cv::Mat g = grey(f.bgr);
+    double unmoved = 0.0, moved = 0.0;
+    int n = 0;
+    for (int v = 0; v < 480; v += 2) {
+      for (int u = 0; u < 640; u += 2) {
+        const int x = 320 + c.scale * (u - 320) + c.du, y = 240 + c.scale * (v - 240);
+        if (x < 0 || x >= 640 || y < 0 || y >= 480) continue;
+        unmoved += std::abs(double(g.at<std::uint8_t>(v, u)) - ref.at<std::uint8_t>(v, u));
+        moved += std::abs(double(g.at<std::uint8_t>(v, u)) - ref.at<std::uint8_t>(y, x));
+        ++n;
+      }
+    }
+    unmoved /= n, moved /= n;
+    std::printf("focal x%.1f, baseline %.1f m: mean grey difference %.2f unmoved, %.2f where "
+                "it looks\n", c.ratio, c.baseline, unmoved, moved);
+    EXPECT_GT(unmoved, 5.0);
+    EXPECT_LT(moved, 0.1 * unmoved);
+  }
 }
 
 TEST(SynthRender, DeterministicForASeed) {

@@ -142,6 +142,27 @@ TEST(SynthTool, SameSeedSameFilesOtherSeedOtherImages) {
   EXPECT_NE(readBytes(a / "groundtruth.txt"), readBytes(c / "groundtruth.txt"));
 }
 
+// --colour-focal-ratio and --colour-baseline change the colour images only (blurred too), and
+// the lists' header says so; the default options write registered colour.
+TEST(SynthTool, AnUnregisteredColourCameraChangesTheColourOnly) {
+  const fs::path a = test::tempDir("synth_tool_registered"),
+                 b = test::tempDir("synth_tool_unregistered");
+  const std::string common = " --frames 2 --width 96 --height 72 --blur on --seed 4";
+  ASSERT_EQ(runTool("'" + a.string() + "'" + common), 0);
+  ASSERT_EQ(runTool("'" + b.string() + "'" + common +
+                    " --colour-focal-ratio 0.897 --colour-baseline 0.025"),
+            0);
+  for (const std::string stamp : {"1000.000000", "1000.033333"}) {
+    EXPECT_EQ(readBytes(a / "depth" / (stamp + ".png")), readBytes(b / "depth" / (stamp + ".png")));
+    EXPECT_NE(readBytes(a / "rgb" / (stamp + ".png")), readBytes(b / "rgb" / (stamp + ".png")));
+  }
+  EXPECT_EQ(readRows(a / "groundtruth.txt"), readRows(b / "groundtruth.txt"));  // the poses
+  EXPECT_EQ(readBytes(a / "camera.yaml"), readBytes(b / "camera.yaml"));
+  EXPECT_EQ(readBytes(a / "rgb.txt").find("unregistered"), std::string::npos);
+  EXPECT_NE(readBytes(b / "rgb.txt").find("colour unregistered: focal x0.897, baseline 0.025 m"),
+            std::string::npos);
+}
+
 TEST(SynthTool, HelpAndBadOptions) {
   EXPECT_EQ(runTool("--help"), 0);
   const std::string out = "'" + test::tempDir("synth_tool_bad").string() + "'";
@@ -155,6 +176,8 @@ TEST(SynthTool, HelpAndBadOptions) {
   EXPECT_EQ(runTool(out + " --motion spiral"), 2);
   EXPECT_EQ(runTool(out + " --noise maybe"), 2);
   EXPECT_EQ(runTool(out + " --width 4"), 2);
+  EXPECT_EQ(runTool(out + " --colour-focal-ratio 0.2"), 2);
+  EXPECT_EQ(runTool(out + " --colour-baseline 2"), 2);
   EXPECT_EQ(runTool(out + " --colour red"), 2);  // unknown option
   EXPECT_FALSE(fs::exists(test::tempDir("synth_tool_bad") / "rgb.txt"));
   // A folder that cannot be created is a run-time failure, not a usage error.
