@@ -23,4 +23,8 @@ struct Frame {
   std::string problem() const;
 };
 
+// The colour image as 8-bit grey (OpenCV's weights), from its real channel order; the image
+// itself when it is grey already.
+cv::Mat grayImage(const Frame& frame);
+
 }  // namespace acvo

@@ -37,6 +37,7 @@
 
 #include "acvo/AcvoConfig.h"
 #include "acvo/ResetToPose.h"
+#include "acvo/colour_depth_check.hpp"
 #include "acvo/odometry.hpp"
 #include "cause_throttle.hpp"
 #include "conversions.hpp"
@@ -92,6 +93,7 @@ class OdometryNodelet : public nodelet::Nodelet {
   void processFrame(const Image& rgb, const Image& depth, const Info& info);
   bool acceptStamp(const ros::Time& stamp);
   void reject(const std_msgs::Header& header, const std::string& why, double ms_total);
+  void checkRegistration(const acvo::Frame& frame);
   std::string baseFrame() const;
   bool baseIsCamera() const;
   std::optional<Eigen::Isometry3d> lookup(const std::string& target, const std::string& source,
@@ -167,6 +169,9 @@ class OdometryNodelet : public nodelet::Nodelet {
   std::optional<Eigen::Isometry3d> base_from_camera_;  // looked up once per camera frame
   bool base_waited_ = false;  // waited once for base_from_camera_ (per camera frame)
   bool frame_ids_warned_ = false;
+  // Whether the depth is registered to the colour, from the images themselves: every 3rd
+  // processed frame until it decides (10 with enough depth edges), then once in the log.
+  acvo::ColourDepthCheck colour_check_;
   ContinuousOdom continuous_;  // the published pose (odom_continuity.hpp)
   // A base pose to start from (initial_pose, or reset_odom_to_pose before the camera-to-base
   // transform was known): applied at the first frame whose transform is known.
@@ -353,6 +358,7 @@ void OdometryNodelet::processFrame(const Image& rgb, const Image& depth, const I
   }
   if (header.frame_id != camera_frame_) {
     camera_frame_ = header.frame_id;
+    colour_check_ = acvo::ColourDepthCheck();  // another camera: look again
     base_from_camera_.reset();
     base_waited_ = false;
   }
@@ -364,6 +370,7 @@ void OdometryNodelet::processFrame(const Image& rgb, const Image& depth, const I
   }
   acvo::OdometryResult r = odometry_->process(frame, tf.motion_guess);
   ++count_.frames;
+  checkRegistration(frame);
   if (!tf.base_from_camera && r.tracking != acvo::Tracking::kBadFrame) {
     r.message += std::string(r.message.empty() ? "" : "; ") + "not published: no transform from '" +
                  baseFrame() + "' to '" + camera_frame_ + "' yet";
@@ -435,6 +442,16 @@ bool OdometryNodelet::acceptStamp(const ros::Time& stamp) {
       return true;
   }
   return false;
+}
+
+void OdometryNodelet::checkRegistration(const acvo::Frame& frame) {
+  if (colour_check_.decided() || count_.frames % 3 != 1) return;
+  colour_check_.add(frame);
+  if (colour_check_.verdict().state == acvo::ColourDepthCheck::State::kUnregistered) {
+    NODELET_WARN("%s", colour_check_.describe().c_str());
+  } else if (colour_check_.decided()) {
+    NODELET_INFO("%s", colour_check_.describe().c_str());
+  }
 }
 
 void OdometryNodelet::reject(const std_msgs::Header& header, const std::string& why,
@@ -737,6 +754,7 @@ void OdometryNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat
   stat.add("last message", last_.message);
   stat.add("last ms total", last_.ms_total);
   stat.add("last ms latency", last_.ms_latency);
+  stat.add("colour/depth registration", acvo::toString(colour_check_.verdict().state));
   stat.add("parameter problems",
            parameter_problems_.empty() ? std::string("none") : parameter_problems_);
   stat.add("messages received (rgb, depth, info)", std::to_string(count_.rgb.load()) + ", " +

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "acvo/colour_depth_check.hpp"
 #include "acvo/odometry.hpp"
 #include "acvo/params.hpp"
 #include "acvo/tum.hpp"
@@ -115,6 +116,7 @@ int main(int argc, char** argv) {
     odometry.reset(world_from_first);
 
     const bool progress = isatty(STDERR_FILENO);
+    acvo::ColourDepthCheck colour_check;  // every 3rd frame until it decides
     acvo::Trajectory trajectory;
     std::vector<double> frame_ms;
     long failures = 0;
@@ -122,7 +124,13 @@ int main(int argc, char** argv) {
       const auto& entry = data.frames()[std::size_t(k)];
       acvo::OdometryResult r;
       try {
-        r = odometry.process(data.loadFrame(std::size_t(k)));
+        const acvo::Frame frame = data.loadFrame(std::size_t(k));
+        r = odometry.process(frame);
+        if (!colour_check.decided() && (k - first) % 3 == 0 && colour_check.add(frame).state ==
+                                                                   acvo::ColourDepthCheck::State::kUnregistered) {
+          std::cerr << (progress ? "\n" : "") << "acvo_tum: warning: " << colour_check.describe()
+                    << "\n";
+        }
       } catch (const std::exception& e) {
         std::cerr << "\nacvo_tum: frame " << k << " skipped: " << e.what() << "\n";
         ++failures;

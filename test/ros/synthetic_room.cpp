@@ -25,10 +25,12 @@ acvo::Camera testCamera() {
   return c;
 }
 
-RgbdImage renderRoom(const Eigen::Isometry3d& world_from_camera, const acvo::Camera& camera) {
+RgbdImage renderRoom(const Eigen::Isometry3d& world_from_camera, const acvo::Camera& camera,
+                     double colour_focal_ratio) {
   acvo::synth::RenderOptions options;
   options.camera = camera;
   options.noise = false;
+  options.colour_focal_ratio = colour_focal_ratio;
   const acvo::synth::SynthFrame f = acvo::synth::render(scene(), world_from_camera, options);
   RgbdImage out;
   cv::cvtColor(f.bgr, out.rgb, cv::COLOR_BGR2RGB);

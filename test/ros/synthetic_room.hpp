@@ -20,7 +20,10 @@ struct RgbdImage {
 acvo::Camera testCamera();
 
 // The room seen by a camera at `world_from_camera` (optical frame: x right, y down, z forward).
-RgbdImage renderRoom(const Eigen::Isometry3d& world_from_camera, const acvo::Camera& camera);
+// colour_focal_ratio != 1: the colour from an unregistered camera with that many times the
+// focal length (acvo::synth::RenderOptions), as a driver's raw depth would be paired with it.
+RgbdImage renderRoom(const Eigen::Isometry3d& world_from_camera, const acvo::Camera& camera,
+                     double colour_focal_ratio = 1.0);
 
 // The motion of the camera between consecutive frames (camera k+1 in camera k): 1.5 cm and
 // 0.6 degrees, in all axes (0.45 m/s and 18 deg/s at 30 Hz, a brisk hand-held motion).

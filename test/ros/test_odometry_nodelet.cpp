@@ -1403,6 +1403,51 @@ TEST(OdometryNodelet, ABadParameterIsRejectedAloneAndAnUnknownOneIsNamed) {
   EXPECT_EQ(problems->find("target_points"), std::string::npos) << *problems;
 }
 
+// Whether the depth is registered to the colour is judged from the images (every 3rd frame,
+// 10 with enough depth edges): the registered room of the tests before says so in diagnostics
+// without a warning. A camera whose colour comes from a second camera with 0.897 times the focal
+// length (7-Scenes', a raw depth image's) is judged again from its first frame and named with
+// what to do; its frames are still processed.
+TEST(OdometryNodelet, DepthNotRegisteredToTheColourIsNamed) {
+  const ros::WallTime since = ros::WallTime::now();
+  ASSERT_TRUE(client->reset());
+  client->run(range(0, 31));
+  // Diagnostics come once a second: the value once it is `want`, or the last one after 5 s.
+  auto judged = [](const std::string& want) {
+    std::optional<std::string> v;
+    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(5.0);
+    do {
+      v = client->diagnosticValue("colour/depth registration");
+      if (v == want) break;
+      ros::WallDuration(0.1).sleep();
+    } while (ros::WallTime::now() < deadline);
+    return v;
+  };
+  EXPECT_EQ(judged("registered"), "registered");
+  EXPECT_FALSE(client->waitLog("does not look registered", since, 0.5));
+
+  const std::string other_camera = "unregistered_camera_optical_frame";
+  for (int k = 31; k < 70; ++k) {
+    const RgbdImage img = acvo_test::renderRoom(
+        acvo_test::worldFromFirstCamera() * cameraPose(k), acvo_test::testCamera(), 0.897);
+    const ros::Time t = client->nextStamp();
+    client->send(img, t, [&](auto& rgb, auto& depth, auto& info) {
+      rgb.header.frame_id = depth.header.frame_id = info.header.frame_id = other_camera;
+    });
+    client->flush();
+    const Outcome o = client->outcome(t, false);
+    ASSERT_TRUE(o.info) << "frame " << k << ": no odom_info";
+    EXPECT_NE(o.info->tracking, "bad_frame") << o.info->message;
+  }
+  const auto warning = client->waitLog("does not look registered", since);
+  ASSERT_TRUE(warning) << "no warning about the unregistered depth";
+  EXPECT_NE(warning->find("depth_registered"), std::string::npos) << *warning;
+  const auto at = warning->find("focal length ");
+  ASSERT_NE(at, std::string::npos) << *warning;
+  EXPECT_NEAR(std::stod(warning->substr(at + 13, 4)), 0.897, 0.03) << *warning;  // found: 0.91
+  EXPECT_EQ(judged("unregistered"), "unregistered");
+}
+
 TEST(OdometryNodelet, NoDataIsAnError) {
   // no_data_timeout is 3 s in test_params.yaml.
   const auto diag =

@@ -1,8 +1,10 @@
-// What makes a frame unusable (Frame::problem): sizes, types, intrinsics, stamp.
+// What makes a frame unusable (Frame::problem): sizes, types, intrinsics, stamp; its grey image.
 #include "acvo/frame.hpp"
 
 #include <cmath>
 #include <sstream>
+
+#include <opencv2/imgproc.hpp>
 
 namespace acvo {
 
@@ -33,6 +35,14 @@ std::string Frame::problem() const {
     return why.str();
   }
   return {};
+}
+
+cv::Mat grayImage(const Frame& frame) {
+  if (frame.order == ColorOrder::kGray) return frame.color;
+  cv::Mat gray;
+  cv::cvtColor(frame.color, gray,
+               frame.order == ColorOrder::kRgb ? cv::COLOR_RGB2GRAY : cv::COLOR_BGR2GRAY);
+  return gray;
 }
 
 }  // namespace acvo

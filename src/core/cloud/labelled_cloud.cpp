@@ -18,14 +18,6 @@ double msSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
-cv::Mat grayOf(const Frame& frame) {
-  if (frame.order == ColorOrder::kGray) return frame.color;
-  cv::Mat gray;
-  cv::cvtColor(frame.color, gray,
-               frame.order == ColorOrder::kRgb ? cv::COLOR_RGB2GRAY : cv::COLOR_BGR2GRAY);
-  return gray;
-}
-
 // R, G, B of one pixel whatever the frame's channel order (grey replicated).
 std::array<std::uint8_t, 3> rgbAt(const Frame& frame, int u, int v) {
   if (frame.order == ColorOrder::kGray) {
@@ -46,7 +38,7 @@ LabelledCloud buildLabelledCloud(const Frame& frame, const SelectionParams& para
   }
   // ms_selection counts the grey conversion too: it exists only for selection and gradients.
   const auto t0 = Clock::now();
-  const cv::Mat gray = grayOf(frame);
+  const cv::Mat gray = grayImage(frame);
   Selection selection = selectPixels(gray, frame.depth, params);
   const double ms_selection = msSince(t0);
 

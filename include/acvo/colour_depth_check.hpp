@@ -1,0 +1,83 @@
+// Is the depth image registered to the colour image? acvo takes the two pixel for pixel: the
+// colour at (u, v) is the colour of the point whose depth is at (u, v). A raw depth image from a
+// Kinect-type driver (depth_registration off, 7-Scenes' recordings) comes from a second camera
+// with another focal length (the Kinect's colour camera 525 px, its depth camera 585): the
+// colour then lies up to 30 px off its point at the image border, and every colour method
+// suffers (docs/accuracy.md: a rendered room, acvo 0.0004 -> 0.034 m/s).
+//
+// The evidence: where the depth jumps (an object's silhouette) the colour nearly always changes
+// too. Per frame, the colour image's gradient magnitude (Sobel, smoothed by a 1-px Gaussian,
+// normalised to mean 1) is read at the pixels in front of a depth jump (up to 3 px), mapped into a colour
+// camera whose focal length is `ratio` times the depth's, about the same principal point
+// (u' = cx + ratio (u - cx)), for ratios 0.80 ... 1.20 in steps of 0.01. Over enough frames with
+// enough depth edges, a registered pair scores best at ratio 1 (TUM fr3/teddy: 1.01, 1.04x the
+// score at 1; every rendered sequence of docs/accuracy.md within 0.01 of 1), an unregistered one
+// away from it (7-Scenes' kitchen: 0.91, 1.6x; rendered at 0.897: 0.88-0.90, 1.3-1.6x; at 1.1:
+// 1.10, 1.27x). A baseline between the two
+// cameras is not searched: at 2.5 cm it moves the colour by 6 px at 2 m, the focal length up to
+// 30 px, and a two-parameter search mistook texture for silhouettes on rendered rooms.
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "acvo/frame.hpp"
+
+namespace acvo {
+
+class ColourDepthCheck {
+ public:
+  static constexpr int kRatios = 41;  // 0.80, 0.81, ... 1.20
+  static double ratioAt(int i) { return 0.8 + 0.01 * i; }
+
+  struct Options {
+    double depth_jump = 0.05;      // a depth edge: a pixel within 3 px is farther by this x z
+    int min_edge_pixels = 500;     // a frame with fewer depth-edge pixels does not count
+    int frames_needed = 10;        // counted frames before a verdict
+    double min_gain = 1.15;        // unregistered: the best ratio's score over ratio 1's ...
+    double min_offset = 0.04;      // ... the best ratio this far from 1 ...
+    double min_agreement = 0.6;    // ... and this fraction of the frames' own best within 0.03
+  };
+
+  enum class State { kUndecided, kRegistered, kUnregistered };
+
+  struct Verdict {
+    State state = State::kUndecided;
+    double best_ratio = 1.0;  // the colour focal length over the depth's that fits best
+    double gain = 1.0;        // the score at best_ratio over the score at ratio 1
+    double agreement = 0.0;   // fraction of counted frames whose own best is near best_ratio
+    int frames = 0;           // frames counted (enough depth edges)
+    int frames_seen = 0;      // frames given
+  };
+
+  ColourDepthCheck() : ColourDepthCheck(Options{}) {}
+  explicit ColourDepthCheck(const Options& options);
+
+  // Adds one frame's evidence (a frame with problem() is ignored) and returns the verdict so
+  // far; once decided, frames are no longer looked at.
+  const Verdict& add(const Frame& frame);
+  const Verdict& verdict() const { return verdict_; }
+  bool decided() const { return verdict_.state != State::kUndecided; }
+
+  // One line for a log: what was found and, when unregistered, what to do.
+  std::string describe() const;
+
+  // The depth-edge pixels of `depth` (CV_32FC1 metres) as (u, v), and the per-ratio mean of
+  // the normalised gradient magnitude of `grey` (CV_8UC1) there: for tests.
+  static std::vector<std::array<int, 2>> depthEdges(const cv::Mat& depth, double depth_jump);
+  static std::array<double, kRatios> scores(const cv::Mat& grey, const Camera& camera,
+                                            const std::vector<std::array<int, 2>>& edges);
+
+ private:
+  void decide();
+
+  Options options_;
+  std::array<double, kRatios> sum_{};
+  std::vector<int> frame_best_;  // per counted frame, the index of its best ratio
+  Verdict verdict_;
+};
+
+std::string toString(ColourDepthCheck::State state);
+
+}  // namespace acvo
