@@ -53,7 +53,7 @@ std::vector<std::array<int, 2>> ColourDepthCheck::depthEdges(const cv::Mat& dept
 std::array<double, ColourDepthCheck::kRatios> ColourDepthCheck::scores(
     const cv::Mat& grey, const Camera& camera, const std::vector<std::array<int, 2>>& edges) {
   std::array<double, kRatios> out{};
-  if (edges.empty()) return out;
+  if (edges.empty() || grey.cols < 2 || grey.rows < 2) return out;
   cv::Mat gx, gy, magnitude;
   cv::Sobel(grey, gx, CV_32F, 1, 0, 3);
   cv::Sobel(grey, gy, CV_32F, 0, 1, 3);
