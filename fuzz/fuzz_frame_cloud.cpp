@@ -1,6 +1,7 @@
 // Fuzz target: arbitrary bytes -> a small RGB-D frame -> labelled cloud -> registration ->
-// odometry. Whatever the images and intrinsics hold (NaN or infinite depth, zero or negative
-// focal lengths, mismatched sizes), nothing may crash, and the odometry pose stays finite.
+// odometry, and the colour/depth registration check. Whatever the images and intrinsics hold
+// (NaN or infinite depth, zero or negative focal lengths, mismatched sizes), nothing may crash,
+// the odometry pose stays finite and the check's figures too.
 //
 // Input layout (every read past the end gives zeros):
 //   byte 0, 1   width, height: 8 + b % 89 (8..96 pixels)
@@ -25,6 +26,7 @@
 #include <tbb/global_control.h>
 #include <opencv2/imgproc.hpp>
 
+#include "acvo/colour_depth_check.hpp"
 #include "acvo/depth.hpp"
 #include "acvo/frame.hpp"
 #include "acvo/registration/coarse_to_fine.hpp"
@@ -203,6 +205,20 @@ void checkSolverResult(const acvo::SolverResult& r) {
   FUZZ_CHECK(std::isfinite(r.inner_product));
 }
 
+// The check takes any frame (a bad one is ignored) and decides on two with a single edge pixel.
+void checkColourDepth(const acvo::Frame& a, const acvo::Frame& b) {
+  acvo::ColourDepthCheck::Options options;
+  options.min_edge_pixels = 1;
+  options.frames_needed = 2;
+  acvo::ColourDepthCheck check(options);
+  check.add(a);
+  check.add(b);
+  const auto& v = check.verdict();
+  FUZZ_CHECK(std::isfinite(v.best_ratio) && std::isfinite(v.gain) && v.gain >= 1.0);
+  FUZZ_CHECK(v.agreement >= 0.0 && v.agreement <= 1.0 && v.frames <= v.frames_seen);
+  FUZZ_CHECK(!check.describe().empty());
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -213,6 +229,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
 
   acvo::Odometry odometry(d.params);
   if (!frame.problem().empty()) {
+    checkColourDepth(frame, frame);
     bool threw = false;
     try {
       acvo::buildLabelledCloud(frame, d.params.selection);
@@ -228,6 +245,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
 
   const acvo::Frame moved = shifted(frame, d.shift_x, d.shift_y);
   FUZZ_CHECK(moved.problem().empty());
+  checkColourDepth(frame, moved);
   const acvo::LabelledCloud cloud = acvo::buildLabelledCloud(frame, d.params.selection);
   checkCloud(cloud, frame);
   const acvo::LabelledCloud moved_cloud = acvo::buildLabelledCloud(moved, d.params.selection);
