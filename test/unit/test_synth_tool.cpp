@@ -1,5 +1,6 @@
 // acvo_synth end to end: a tiny sequence on disk, its lists, groundtruth and camera file,
-// determinism, and the errors for bad options.
+// determinism, an unregistered colour camera (and scripts/register_colour undoing it), and the
+// errors for bad options.
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -161,6 +162,56 @@ TEST(SynthTool, AnUnregisteredColourCameraChangesTheColourOnly) {
   EXPECT_EQ(readBytes(a / "rgb.txt").find("unregistered"), std::string::npos);
   EXPECT_NE(readBytes(b / "rgb.txt").find("colour unregistered: focal x0.897, baseline 0.025 m"),
             std::string::npos);
+}
+
+// Mean absolute difference of two 8-bit colour images.
+double meanDifference(const fs::path& a, const fs::path& b) {
+  const cv::Mat x = cv::imread(a.string()), y = cv::imread(b.string());
+  EXPECT_FALSE(x.empty()) << a;
+  EXPECT_EQ(x.size(), y.size()) << b;
+  if (x.empty() || x.size() != y.size()) return 1e9;
+  return cv::norm(x, y, cv::NORM_L1) / double(x.total() * x.channels());
+}
+
+// scripts/register_colour with the colour camera's true parameters brings the colour of an
+// unregistered rendering back to the registered one's (measured: mean difference 17.4 grey
+// levels unregistered, 2.2 registered by the script, 6.8 with the focal ratio alone, 11.4 with
+// the baseline's sign wrong); a folder that exists or parameters out of range are refused.
+TEST(SynthTool, RegisterColourUndoesAnUnregisteredColourCamera) {
+  const fs::path r = test::tempDir("synth_tool_colour_registered"),
+                 u = test::tempDir("synth_tool_colour_unregistered"),
+                 root = test::tempDir("synth_tool_colour_script");
+  const std::string common = " --frames 2 --width 160 --height 120 --noise off";
+  ASSERT_EQ(runTool("'" + r.string() + "'" + common), 0);
+  ASSERT_EQ(runTool("'" + u.string() + "'" + common +
+                    " --colour-focal-ratio 0.897 --colour-baseline 0.025"),
+            0);
+  const fs::path script = test::sourceDir() / "scripts" / "register_colour";
+  auto registerColour = [&](const fs::path& out, const std::string& options) {
+    const std::string command = "'" + script.string() + "' '" + u.string() + "' '" +
+                                out.string() + "' " + options + " >/dev/null 2>&1";
+    const int status = std::system(command.c_str());
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  };
+  const fs::path right = root / "right", sign = root / "sign", focal = root / "focal";
+  ASSERT_EQ(registerColour(right, "--focal-ratio 0.897 --baseline 0.025"), 0);
+  ASSERT_EQ(registerColour(sign, "--focal-ratio 0.897 --baseline -0.025"), 0);
+  ASSERT_EQ(registerColour(focal, "--focal-ratio 0.897"), 0);
+  for (const std::string image : {"rgb/1000.000000.png", "rgb/1000.033333.png"}) {
+    const double as_recorded = meanDifference(u / image, r / image);
+    const double registered = meanDifference(right / image, r / image);
+    EXPECT_GT(as_recorded, 12.0) << image;
+    EXPECT_LT(registered, 3.5) << image;
+    EXPECT_GT(meanDifference(focal / image, r / image), 1.5 * registered) << image;
+    EXPECT_GT(meanDifference(sign / image, r / image), 2.0 * registered) << image;
+    // The depth is not touched.
+    const std::string depth = "depth" + image.substr(3);
+    EXPECT_EQ(readBytes(right / depth), readBytes(u / depth));
+  }
+  EXPECT_EQ(readRows(right / "groundtruth.txt"), readRows(u / "groundtruth.txt"));
+  EXPECT_NE(registerColour(right, "--focal-ratio 0.897"), 0);  // exists
+  EXPECT_NE(registerColour(root / "bad", "--focal-ratio 3"), 0);
+  EXPECT_FALSE(fs::exists(root / "bad"));
 }
 
 TEST(SynthTool, HelpAndBadOptions) {
