@@ -7,15 +7,15 @@
 //
 // The evidence: where the depth jumps (an object's silhouette) the colour nearly always changes
 // too. Per frame, the colour image's gradient magnitude (Sobel, smoothed by a 1-px Gaussian,
-// normalised to mean 1) is read at the pixels in front of a depth jump (up to 3 px), mapped into a colour
-// camera whose focal length is `ratio` times the depth's, about the same principal point
-// (u' = cx + ratio (u - cx)), for ratios 0.80 ... 1.20 in steps of 0.01. Over enough frames with
-// enough depth edges, a registered pair scores best at ratio 1 (TUM fr3/teddy: 1.01, 1.04x the
-// score at 1; every rendered sequence of docs/accuracy.md within 0.01 of 1), an unregistered one
-// away from it (7-Scenes' kitchen: 0.91, 1.6x; rendered at 0.897: 0.88-0.90, 1.3-1.6x; at 1.1:
-// 1.10, 1.27x). A baseline between the two
-// cameras is not searched: at 2.5 cm it moves the colour by 6 px at 2 m, the focal length up to
-// 30 px, and a two-parameter search mistook texture for silhouettes on rendered rooms.
+// normalised to mean 1) is read at the pixels in front of a depth jump (up to 3 px), mapped
+// into a colour camera whose focal length is `ratio` times the depth's, about the same
+// principal point (u' = cx + ratio (u - cx)), for ratios 0.80 ... 1.20 in steps of 0.01. Over
+// enough frames with enough depth edges, a registered pair scores best at ratio 1 (TUM
+// fr3/teddy: 1.01, 1.04x the score at 1; every rendered sequence of docs/accuracy.md within
+// 0.01 of 1), an unregistered one away from it (7-Scenes' kitchen: 0.91, 1.6x; rendered at
+// 0.897: 0.88-0.90, 1.3-1.6x; at 1.1: 1.10, 1.27x). A baseline between the two cameras is not
+// searched: at 2.5 cm it moves the colour by 6 px at 2 m, the focal length up to 30 px, and a
+// two-parameter search mistook texture for silhouettes on rendered rooms.
 #pragma once
 
 #include <array>
@@ -29,7 +29,11 @@ namespace acvo {
 class ColourDepthCheck {
  public:
   static constexpr int kRatios = 41;  // 0.80, 0.81, ... 1.20
-  static double ratioAt(int i) { return 0.8 + 0.01 * i; }
+  static constexpr double kRatioStep = 0.01;
+  static double ratioAt(int i) { return 0.8 + kRatioStep * i; }
+  // The nodelet and acvo_tum give it every kFrameStep-th frame until it decides: neighbouring
+  // frames add little evidence, and a frame looked at costs about 3 ms at 640x480.
+  static constexpr int kFrameStep = 3;
 
   struct Options {
     double depth_jump = 0.05;      // a depth edge: a pixel within 3 px is farther by this x z
@@ -37,7 +41,8 @@ class ColourDepthCheck {
     int frames_needed = 10;        // counted frames before a verdict
     double min_gain = 1.15;        // unregistered: the best ratio's score over ratio 1's ...
     double min_offset = 0.04;      // ... the best ratio this far from 1 ...
-    double min_agreement = 0.6;    // ... and this fraction of the frames' own best within 0.03
+    double min_agreement = 0.6;    // ... and this fraction of the frames' own best within
+    double agreement_within = 0.03;  // this of the best ratio
   };
 
   enum class State { kUndecided, kRegistered, kUnregistered };
@@ -46,7 +51,8 @@ class ColourDepthCheck {
     State state = State::kUndecided;
     double best_ratio = 1.0;  // the colour focal length over the depth's that fits best
     double gain = 1.0;        // the score at best_ratio over the score at ratio 1
-    double agreement = 0.0;   // fraction of counted frames whose own best is near best_ratio
+    double agreement = 0.0;   // fraction of counted frames whose own best is within
+                              // agreement_within of best_ratio
     int frames = 0;           // frames counted (enough depth edges)
     int frames_seen = 0;      // frames given
   };

@@ -169,8 +169,8 @@ class OdometryNodelet : public nodelet::Nodelet {
   std::optional<Eigen::Isometry3d> base_from_camera_;  // looked up once per camera frame
   bool base_waited_ = false;  // waited once for base_from_camera_ (per camera frame)
   bool frame_ids_warned_ = false;
-  // Whether the depth is registered to the colour, from the images themselves: every 3rd
-  // processed frame until it decides (10 with enough depth edges), then once in the log.
+  // Whether the depth is registered to the colour, from the images themselves: every
+  // kFrameStep-th processed frame until it decides, then once in the log.
   acvo::ColourDepthCheck colour_check_;
   ContinuousOdom continuous_;  // the published pose (odom_continuity.hpp)
   // A base pose to start from (initial_pose, or reset_odom_to_pose before the camera-to-base
@@ -445,7 +445,7 @@ bool OdometryNodelet::acceptStamp(const ros::Time& stamp) {
 }
 
 void OdometryNodelet::checkRegistration(const acvo::Frame& frame) {
-  if (colour_check_.decided() || count_.frames % 3 != 1) return;
+  if (colour_check_.decided() || count_.frames % acvo::ColourDepthCheck::kFrameStep != 1) return;
   colour_check_.add(frame);
   if (colour_check_.verdict().state == acvo::ColourDepthCheck::State::kUnregistered) {
     NODELET_WARN("%s", colour_check_.describe().c_str());

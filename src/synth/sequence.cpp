@@ -39,7 +39,7 @@ std::string describe(const SequenceOptions& o) {
     << (o.structure ? "on" : "off") << ", texture " << (o.texture ? "on" : "off") << ", noise "
     << (o.noise ? "on" : "off") << ", blur " << (o.blur ? "on" : "off") << ", " << o.camera.width
     << "x" << o.camera.height;
-  if (o.colour_focal_ratio != 1.0 || o.colour_baseline != 0.0) {
+  if (!o.renderOptions().colourRegistered()) {
     s << ", colour unregistered: focal x" << o.colour_focal_ratio << ", baseline "
       << o.colour_baseline << " m";
   }

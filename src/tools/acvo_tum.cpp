@@ -116,7 +116,7 @@ int main(int argc, char** argv) {
     odometry.reset(world_from_first);
 
     const bool progress = isatty(STDERR_FILENO);
-    acvo::ColourDepthCheck colour_check;  // every 3rd frame until it decides
+    acvo::ColourDepthCheck colour_check;
     acvo::Trajectory trajectory;
     std::vector<double> frame_ms;
     long failures = 0;
@@ -126,8 +126,8 @@ int main(int argc, char** argv) {
       try {
         const acvo::Frame frame = data.loadFrame(std::size_t(k));
         r = odometry.process(frame);
-        if (!colour_check.decided() && (k - first) % 3 == 0 && colour_check.add(frame).state ==
-                                                                   acvo::ColourDepthCheck::State::kUnregistered) {
+        if (!colour_check.decided() && (k - first) % acvo::ColourDepthCheck::kFrameStep == 0 &&
+            colour_check.add(frame).state == acvo::ColourDepthCheck::State::kUnregistered) {
           std::cerr << (progress ? "\n" : "") << "acvo_tum: warning: " << colour_check.describe()
                     << "\n";
         }

@@ -18,11 +18,12 @@ namespace {
 
 using State = ColourDepthCheck::State;
 
-// Every 3rd frame of a rendered sequence (as the nodelet and acvo_tum look), until decided.
+// Every kFrameStep-th frame of a rendered sequence (as the nodelet and acvo_tum look), until
+// decided.
 ColourDepthCheck::Verdict judge(synth::SequenceOptions o) {
   const synth::SynthSequence sequence(o);
   ColourDepthCheck check;
-  for (int i = 0; i < sequence.size() && !check.decided(); i += 3) {
+  for (int i = 0; i < sequence.size() && !check.decided(); i += ColourDepthCheck::kFrameStep) {
     check.add(sequence.frame(i).toFrame());
   }
   return check.verdict();
@@ -129,7 +130,10 @@ TEST(ColourDepthCheck, TooFewDepthEdgesDecideNothing) {
 ColourDepthCheck::Verdict judgeFolder(const std::filesystem::path& folder) {
   const TumDataset data(folder.string());
   ColourDepthCheck check;
-  for (std::size_t i = 0; i < data.size() && !check.decided(); i += 3) check.add(data.loadFrame(i));
+  for (std::size_t i = 0; i < data.size() && !check.decided();
+       i += ColourDepthCheck::kFrameStep) {
+    check.add(data.loadFrame(i));
+  }
   return check.verdict();
 }
 

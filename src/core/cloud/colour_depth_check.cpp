@@ -95,10 +95,13 @@ void ColourDepthCheck::decide() {
   const int one = kRatios / 2;  // ratio 1.00
   verdict_.best_ratio = ratioAt(best);
   verdict_.gain = sum_[std::size_t(best)] / sum_[std::size_t(one)];
+  // Options in ratios, as whole steps of the ratio grid.
+  auto steps = [](double ratio) { return int(std::lround(ratio / kRatioStep)); };
+  const int within = steps(options_.agreement_within);
   const int near = int(std::count_if(frame_best_.begin(), frame_best_.end(),
-                                     [best](int b) { return std::abs(b - best) <= 3; }));
+                                     [&](int b) { return std::abs(b - best) <= within; }));
   verdict_.agreement = double(near) / double(frame_best_.size());
-  const bool unregistered = std::abs(best - one) >= int(std::lround(options_.min_offset * 100)) &&
+  const bool unregistered = std::abs(best - one) >= steps(options_.min_offset) &&
                             verdict_.gain >= options_.min_gain &&
                             verdict_.agreement >= options_.min_agreement;
   verdict_.state = unregistered ? State::kUnregistered : State::kRegistered;
