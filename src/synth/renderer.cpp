@@ -126,6 +126,7 @@ Frame SynthFrame::toFrame() const {
   f.depth = depth_m;
   f.camera = camera;
   f.stamp = stamp;
+  f.depth_stamp = depth_stamp;
   return f;
 }
 

@@ -47,6 +47,9 @@ struct SynthFrame {
                     // from the exact rendering at `pose` (not blurred, not degraded)
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  // camera-to-world, optical frame
   double stamp = 0.0;                                      // seconds (set by sequences)
+  // The depth's own stamp when the colour was taken at another time (SequenceOptions::
+  // colour_delay; `stamp` is then the colour's, `pose` the depth's); 0 when they are one.
+  double depth_stamp = 0.0;
   Camera camera;
 
   // As a core Frame (colour shared, not copied; order BGR).

@@ -29,6 +29,9 @@ const SequenceOptions& validated(const SequenceOptions& o) {
     throw std::invalid_argument("colour_focal_ratio must be within [0.5, 2]");
   if (!(std::abs(o.colour_baseline) <= 1))
     throw std::invalid_argument("colour_baseline must be within [-1, 1] m");
+  // Less than half a frame either way keeps the stamps in order.
+  if (!(std::abs(o.colour_delay) * o.rate < 0.5))
+    throw std::invalid_argument("colour_delay must be under half a frame interval");
   return o;
 }
 
@@ -43,6 +46,7 @@ std::string describe(const SequenceOptions& o) {
     s << ", colour unregistered: focal x" << o.colour_focal_ratio << ", baseline "
       << o.colour_baseline << " m";
   }
+  if (o.colour_delay != 0.0) s << ", colour taken " << o.colour_delay << " s after the depth";
   return s.str();
 }
 
@@ -98,22 +102,34 @@ SynthSequence::SynthSequence(const SequenceOptions& options)
   for (int i = 0; i < options_.frames; ++i) poses_.push_back(motion_.poseAt(i / options_.rate));
 }
 
+Eigen::Isometry3d SynthSequence::colourPose(int i) const {
+  if (options_.colour_delay == 0.0) return poses_.at(std::size_t(i));
+  return motion_.poseAt(i / options_.rate + options_.colour_delay);
+}
+
 SynthFrame SynthSequence::frame(int i) const {
   if (i < 0 || i >= size()) throw std::out_of_range("synthetic frame index out of range");
   const std::uint64_t noise_seed = hashCombine(hashCombine(options_.seed, 3), i);
   const RenderOptions render_options = options_.renderOptions();
-  SynthFrame f;
-  if (options_.blur && options_.blur_samples > 1 && options_.exposure > 0) {
-    // Sub-frame poses spread evenly over the shutter time, centred on the frame's time.
+  // The frame of `pose` at time t, blurred over the shutter time centred on t.
+  auto renderAt = [&](const Eigen::Isometry3d& pose, double t, std::uint64_t seed) {
+    if (!(options_.blur && options_.blur_samples > 1 && options_.exposure > 0))
+      return render(scene_, pose, render_options, seed);
     std::vector<Eigen::Isometry3d> exposure;
-    const double t = i / options_.rate, shutter = options_.exposure / options_.rate;
+    const double shutter = options_.exposure / options_.rate;
     for (int k = 0; k < options_.blur_samples; ++k)
       exposure.push_back(motion_.poseAt(t + shutter * (k / (options_.blur_samples - 1.0) - 0.5)));
-    f = renderBlurred(scene_, poses_[i], exposure, render_options, noise_seed);
-  } else {
-    f = render(scene_, poses_[i], render_options, noise_seed);
-  }
+    return renderBlurred(scene_, pose, exposure, render_options, seed);
+  };
+  const double t = i / options_.rate;
+  SynthFrame f = renderAt(poses_[i], t, noise_seed);
   f.stamp = stamp(i);
+  if (options_.colour_delay != 0.0) {
+    // The colour of the pose colour_delay later, with noise of its own.
+    f.bgr = renderAt(colourPose(i), t + options_.colour_delay, hashCombine(noise_seed, 5)).bgr;
+    f.depth_stamp = f.stamp;
+    f.stamp += options_.colour_delay;
+  }
   return f;
 }
 
@@ -147,7 +163,8 @@ void writeSequence(const std::string& folder, const SequenceOptions& options,
   std::vector<std::string> stamps(n);
   for (int i = 0; i < n; ++i) {
     stamps[i] = formatStamp(sequence.stamp(i));
-    rgb[i] = {stamps[i], "rgb/" + stamps[i] + ".png"};
+    const std::string rgb_stamp = formatStamp(sequence.stamp(i) + options.colour_delay);
+    rgb[i] = {rgb_stamp, "rgb/" + rgb_stamp + ".png"};
     depth[i] = {stamps[i], "depth/" + stamps[i] + ".png"};
   }
 
@@ -171,11 +188,27 @@ void writeSequence(const std::string& folder, const SequenceOptions& options,
   writeFileList((root / "rgb.txt").string(), "color images\n" + about, rgb);
   writeFileList((root / "depth.txt").string(), "depth maps\n" + about, depth);
   writeAssociations((root / "associations.txt").string(), about, rgb, depth);
+  // With the colour taken later, the poses of both stamps, in time order (as a motion-capture
+  // trajectory at a higher rate than the camera's holds both).
+  std::vector<std::string> truth_stamps = stamps;
+  std::vector<Eigen::Isometry3d> truth_poses = sequence.poses();
+  if (options.colour_delay != 0.0) {
+    truth_stamps.clear();
+    truth_poses.clear();
+    for (int i = 0; i < n; ++i) {
+      const bool colour_first = options.colour_delay < 0.0;
+      for (int k = 0; k < 2; ++k) {
+        const bool colour = (k == 0) == colour_first;
+        truth_stamps.push_back(colour ? rgb[i].stamp : stamps[i]);
+        truth_poses.push_back(colour ? sequence.colourPose(i) : sequence.poses()[i]);
+      }
+    }
+  }
   writeGroundtruth((root / "groundtruth.txt").string(),
                    "ground truth trajectory: camera-to-world, optical frame (x right, y down, "
                    "z forward)\n" +
                        about,
-                   stamps, sequence.poses());
+                   truth_stamps, truth_poses);
   saveCameraYaml((root / "camera.yaml").string(), options.camera);
 }
 

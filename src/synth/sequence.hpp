@@ -37,6 +37,9 @@ struct SequenceOptions {
   double exposure = 0.5;        // shutter time as a fraction of the frame interval (blur)
   double colour_focal_ratio = 1.0;  // an unregistered colour camera (RenderOptions)
   double colour_baseline = 0.0;     // m
+  // Colour captured colour_delay seconds after the depth (unsynchronised streams): rendered at
+  // the pose of that time and stamped with it in rgb.txt and associations.txt.
+  double colour_delay = 0.0;
   Camera camera;                // TUM default intrinsics, 640x480, depth scale 5000
   double first_stamp = 1000.0;  // seconds; frame i is at first_stamp + i / rate
 
@@ -53,12 +56,14 @@ class SynthSequence {
  public:
   // Throws std::invalid_argument for bad options (frames < 0, rate <= 0, speed < 0,
   // invalid camera, blur_samples < 1, exposure outside [0, 1], colour_focal_ratio outside
-  // [0.5, 2], colour_baseline not within 1 m).
+  // [0.5, 2], colour_baseline not within 1 m, colour_delay not under half a frame interval).
   explicit SynthSequence(const SequenceOptions& options);
 
   int size() const { return options_.frames; }
   double stamp(int i) const { return options_.first_stamp + i / options_.rate; }
   const std::vector<Eigen::Isometry3d>& poses() const { return poses_; }  // camera-to-world
+  // Where frame i's colour was taken: poses()[i] unless options().colour_delay.
+  Eigen::Isometry3d colourPose(int i) const;
   const Scene& scene() const { return scene_; }
   const Motion& motion() const { return motion_; }
   const SequenceOptions& options() const { return options_; }

@@ -2,6 +2,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <iostream>
@@ -84,6 +85,13 @@ int main(int argc, char** argv) {
       ->type_name("M")
       ->capture_default_str()
       ->transform(acvo::tools::numberIn(-1.0, 1.0, "within [-1, 1] m"));
+  app.add_option("--colour-delay", o.colour_delay,
+                 "colour taken S seconds after the depth (negative: before), as unsynchronised "
+                 "streams (a Kinect v1's, a RealSense's): rendered at that time's pose and "
+                 "stamped with it; under half a frame interval")
+      ->type_name("S")
+      ->capture_default_str()
+      ->transform(acvo::tools::numberIn(-0.1, 0.1, "within [-0.1, 0.1] s"));
   const auto size = acvo::tools::numberIn(8, 8192, "within [8, 8192] pixels");
   app.add_option("--width", width, "image width; the 640x480 intrinsics scale with the size")
       ->type_name("W")
@@ -95,6 +103,11 @@ int main(int argc, char** argv) {
       ->transform(size);
   if (const auto status = acvo::tools::parseCommandLine(app, argc, argv)) return *status;
   o.camera = acvo::synth::scaledDefaultCamera(width, height);
+  if (!(std::abs(o.colour_delay) * o.rate < 0.5)) {  // a usage error, before any file is made
+    std::cerr << "acvo_synth: --colour-delay " << o.colour_delay
+              << " is not under half a frame interval at --rate " << o.rate << "\n";
+    return 2;
+  }
 
   const bool show_progress = isatty(fileno(stderr));
   const auto started = std::chrono::steady_clock::now();

@@ -1,6 +1,6 @@
 // acvo_synth end to end: a tiny sequence on disk, its lists, groundtruth and camera file,
-// determinism, an unregistered colour camera (and scripts/register_colour undoing it), and the
-// errors for bad options.
+// determinism, an unregistered colour camera (and scripts/register_colour undoing it), colour
+// taken after the depth, and the errors for bad options.
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -164,6 +164,48 @@ TEST(SynthTool, AnUnregisteredColourCameraChangesTheColourOnly) {
             std::string::npos);
 }
 
+// Colour taken 10 ms after the depth: the colour images stamped and rendered at their own time,
+// the depth as before, the ground truth at both stamps.
+TEST(SynthTool, ColourTakenLaterIsRenderedAndStampedAtItsOwnTime) {
+  const fs::path a = test::tempDir("synth_tool_synchronised"),
+                 b = test::tempDir("synth_tool_colour_later");
+  const std::string common = " --frames 3 --width 96 --height 72 --seed 4 --noise off";
+  ASSERT_EQ(runTool("'" + a.string() + "'" + common), 0);
+  ASSERT_EQ(runTool("'" + b.string() + "'" + common + " --colour-delay 0.01"), 0);
+  const auto assoc = readRows(b / "associations.txt");
+  const auto gt_a = readRows(a / "groundtruth.txt"), gt_b = readRows(b / "groundtruth.txt");
+  ASSERT_EQ(assoc.size(), 3u);
+  ASSERT_EQ(gt_b.size(), 6u);
+  for (std::size_t i = 0; i < 3; ++i) {
+    const std::string depth_stamp = assoc[i][2], colour_stamp = assoc[i][0];
+    EXPECT_NEAR(std::stod(colour_stamp) - std::stod(depth_stamp), 0.01, 1e-9);
+    EXPECT_EQ(readBytes(a / "depth" / (depth_stamp + ".png")),
+              readBytes(b / "depth" / (depth_stamp + ".png")));
+    EXPECT_TRUE(fs::exists(b / "rgb" / (colour_stamp + ".png")));
+    EXPECT_EQ(gt_b[2 * i], gt_a[i]);           // the depth's pose, as without the delay
+    EXPECT_EQ(gt_b[2 * i + 1][0], colour_stamp);  // then the colour's
+    EXPECT_NE(gt_b[2 * i + 1], gt_a[i]);
+  }
+  // In memory: the colour is the rendering at the colour's pose.
+  SequenceOptions o;
+  o.frames = 2;
+  o.noise = false;
+  o.colour_delay = -0.01;
+  o.camera = scaledDefaultCamera(96, 72);
+  const SynthSequence seq(o);
+  const SynthFrame f = seq.frame(1);
+  EXPECT_DOUBLE_EQ(f.depth_stamp, seq.stamp(1));
+  EXPECT_DOUBLE_EQ(f.stamp, seq.stamp(1) - 0.01);
+  EXPECT_EQ(f.toFrame().depth_stamp, f.depth_stamp);
+  EXPECT_TRUE(seq.colourPose(1).isApprox(seq.motion().poseAt(1.0 / 30.0 - 0.01)));
+  EXPECT_EQ(cv::norm(f.bgr, render(seq.scene(), seq.colourPose(1), o.renderOptions()).bgr,
+                     cv::NORM_INF),
+            0.0);
+  EXPECT_GT(cv::norm(f.bgr, render(seq.scene(), seq.poses()[1], o.renderOptions()).bgr,
+                     cv::NORM_INF),
+            0.0);
+}
+
 // Mean absolute difference of two 8-bit colour images.
 double meanDifference(const fs::path& a, const fs::path& b) {
   const cv::Mat x = cv::imread(a.string()), y = cv::imread(b.string());
@@ -229,6 +271,7 @@ TEST(SynthTool, HelpAndBadOptions) {
   EXPECT_EQ(runTool(out + " --width 4"), 2);
   EXPECT_EQ(runTool(out + " --colour-focal-ratio 0.2"), 2);
   EXPECT_EQ(runTool(out + " --colour-baseline 2"), 2);
+  EXPECT_EQ(runTool(out + " --colour-delay 0.02"), 2);  // over half a frame at 30 Hz
   EXPECT_EQ(runTool(out + " --colour red"), 2);  // unknown option
   EXPECT_FALSE(fs::exists(test::tempDir("synth_tool_bad") / "rgb.txt"));
   // A folder that cannot be created is a run-time failure, not a usage error.
