@@ -5,7 +5,10 @@
 #include <cmath>
 #include <cstdint>
 
+#include <Eigen/Geometry>
 #include <opencv2/core.hpp>
+
+#include "acvo/camera.hpp"
 
 namespace acvo {
 
@@ -34,5 +37,13 @@ struct DepthTraits<float> {
 // invalid pixel (raw 0, NaN, Inf, negative). `units_per_metre`: 5000 for TUM PNG, 1000 for
 // 16UC1 millimetres, 1 for 32FC1 metres. Throws std::invalid_argument for other types.
 cv::Mat depthToMeters(const cv::Mat& raw, double units_per_metre);
+
+// The depth image (CV_32FC1 metres, 0 = invalid) as `camera` sees the same surfaces from
+// another pose: `moved` is that pose in the optical frame of the image's own. Each valid pixel's
+// point is moved and projected to the nearest pixel, the nearest surface kept where several
+// land (as cv::rgbd::registerDepth and depth_image_proc's register do); pixels nothing lands on
+// are 0. Throws std::invalid_argument for another type or a size that is not the camera's.
+cv::Mat depthSeenFrom(const cv::Mat& depth_m, const Camera& camera,
+                      const Eigen::Isometry3d& moved);
 
 }  // namespace acvo

@@ -16,7 +16,11 @@ struct Frame {
   ColorOrder order = ColorOrder::kBgr;
   cv::Mat depth;  // CV_32FC1 metres, 0 = invalid, same size as colour
   Camera camera;
-  double stamp = 0.0;  // seconds
+  double stamp = 0.0;  // seconds: the colour image's (a pose is the camera's at this time)
+  // The depth image's own stamp when the two streams are not synchronised (a Kinect v1's or a
+  // RealSense's colour and depth), 0 when it is the colour's. Odometry moves the depth to the
+  // colour's time (OdometryParams::sync_depth).
+  double depth_stamp = 0.0;
 
   // Empty string when the frame is usable; otherwise says what is wrong with it
   // (empty images, wrong types, size mismatch between colour, depth and camera).

@@ -56,6 +56,10 @@ struct OdometryResult {
   SolverResult solver;                         // the registration that decided this frame
   std::size_t fixed_points = 0;                // points of the cloud registered to
   std::size_t moving_points = 0;
+  // s from the depth's stamp to the colour's (Frame::depth_stamp; 0 when synchronised), and
+  // whether the depth was moved over it (OdometryParams::sync_depth, a velocity known).
+  double depth_delay = 0.0;
+  bool depth_synced = false;
   double ms_cloud = 0.0;  // building this frame's cloud (selection + labels + self-kernel)
   // of which: search grids + self-kernel pairs (a keyframe's grids when it became one)
   double ms_prepare = 0.0;
@@ -151,6 +155,8 @@ class Odometry {
   };
   struct Registration;
   // The steps of process(), in order.
+  // The frame with its depth moved to the colour's time when they differ (sync_depth).
+  Frame depthAtColourTime(const Frame& frame, OdometryResult& r) const;
   std::shared_ptr<PreparedCloud> buildCloud(const Frame& frame, OdometryResult& r);
   void start(OdometryResult& r, const std::shared_ptr<PreparedCloud>& current);
   // To the keyframe from the prior, then (lost) to the last tracked frame; fills r's solver

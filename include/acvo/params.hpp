@@ -140,6 +140,10 @@ struct OdometryParams {
   // (a hand-held camera: 0.35 m/s and up to 100 deg/s on TUM fr3/teddy).
   double lost_speed = 1.0;           // m/s
   double lost_angular_speed = 90.0;  // deg/s
+  // Colour and depth taken at different times (Frame::depth_stamp): the depth is moved to the
+  // colour's time by the last frame-to-frame motion (constant velocity), so that each point's
+  // colour and position are of one instant. Off: the two are paired as they come.
+  bool sync_depth = true;
 };
 
 struct Params {
@@ -232,6 +236,7 @@ void visitParams(Params_& p, Visitor&& visit) {
   visit("odometry", "max_rotation", p.odometry.max_rotation);
   visit("odometry", "lost_speed", p.odometry.lost_speed);
   visit("odometry", "lost_angular_speed", p.odometry.lost_angular_speed);
+  visit("odometry", "sync_depth", p.odometry.sync_depth);
 }
 
 // The paper's A-CVO as the authors' code runs it (config/paper.yaml; docs/method.md §4 says

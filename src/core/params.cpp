@@ -237,6 +237,7 @@ Params paperParams() {
   // failed or the motion is implausible, never for a low overlap.
   p.odometry.lost_matched_fraction = 0.0;
   p.odometry.hard_matched_fraction = 0.05;
+  p.odometry.sync_depth = false;  // colour and depth paired as they come
   return p;
 }
 

@@ -229,6 +229,7 @@ std::variant<acvo::Frame, Rejection> frameFromMessages(const sensor_msgs::Image&
   frame.depth = metres.metres;
   frame.camera = camera.camera;
   frame.stamp = rgb.header.stamp.toSec();
+  frame.depth_stamp = depth.header.stamp.toSec();
   if (std::string problem = frame.problem(); !problem.empty()) return Rejection{problem};
   return frame;
 }

@@ -153,6 +153,8 @@ class OdometryNodelet : public nodelet::Nodelet {
     std::string message;
     double ms_total = 0.0;
     double ms_latency = 0.0;
+    double depth_delay = 0.0;   // s from the depth's stamp to the colour's
+    bool depth_synced = false;  // the depth was moved to the colour's time
     ros::WallTime wall;  // last synchronised frame, good or bad
   };
 
@@ -169,6 +171,7 @@ class OdometryNodelet : public nodelet::Nodelet {
   std::optional<Eigen::Isometry3d> base_from_camera_;  // looked up once per camera frame
   bool base_waited_ = false;  // waited once for base_from_camera_ (per camera frame)
   bool frame_ids_warned_ = false;
+  bool depth_sync_told_ = false;  // said once that colour and depth stamps differ
   // Whether the depth is registered to the colour, from the images themselves: every
   // kFrameStep-th processed frame until it decides, then once in the log.
   acvo::ColourDepthCheck colour_check_;
@@ -377,6 +380,15 @@ void OdometryNodelet::processFrame(const Image& rgb, const Image& depth, const I
   }
   last_.tracking = r.tracking;
   last_.message = r.message;
+  last_.depth_delay = r.depth_delay;
+  last_.depth_synced = r.depth_synced;
+  if (r.depth_synced && !depth_sync_told_) {
+    depth_sync_told_ = true;
+    NODELET_INFO("colour and depth stamps differ (%.1f ms on this frame): each frame's depth is "
+                 "moved to its colour's time by the last frame-to-frame motion "
+                 "(odometry/sync_depth)",
+                 1e3 * r.depth_delay);
+  }
   InfoExtras extras;
   extras.guess_from_tf = tf.motion_guess.has_value() && r.tracking != acvo::Tracking::kFirstFrame;
   if (r.tracking == acvo::Tracking::kBadFrame) {
@@ -755,6 +767,8 @@ void OdometryNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat
   stat.add("last ms total", last_.ms_total);
   stat.add("last ms latency", last_.ms_latency);
   stat.add("colour/depth registration", acvo::toString(colour_check_.verdict().state));
+  stat.addf("colour stamp - depth stamp (ms)", "%.2f%s", 1e3 * last_.depth_delay,
+            last_.depth_synced ? ", depth moved to the colour's time" : "");
   stat.add("parameter problems",
            parameter_problems_.empty() ? std::string("none") : parameter_problems_);
   stat.add("messages received (rgb, depth, info)", std::to_string(count_.rgb.load()) + ", " +

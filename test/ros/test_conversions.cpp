@@ -249,11 +249,13 @@ TEST(FrameFromMessages, GivesTheFrameOrSaysWhyNotNamingTheTopic) {
   rgb.header.frame_id = "/cam_optical";
   rgb.header.stamp = ros::Time(12, 500000000);
   sensor_msgs::Image depth = image(enc::TYPE_16UC1, 4, 3, 2);
+  depth.header.stamp = ros::Time(12, 488000000);  // unsynchronised streams: its own stamp
   const sensor_msgs::CameraInfo good_info = info(3, 3, 2, 1.5, 4, 3);
   const auto ok = frameFromMessages(rgb, depth, good_info, {}, topics);
   ASSERT_TRUE(std::holds_alternative<acvo::Frame>(ok)) << std::get<Rejection>(ok).why;
   const acvo::Frame& f = std::get<acvo::Frame>(ok);
   EXPECT_EQ(f.stamp, 12.5);
+  EXPECT_DOUBLE_EQ(f.depth_stamp, 12.488);
   EXPECT_EQ(f.order, acvo::ColorOrder::kRgb);
   EXPECT_EQ(f.camera.fx, 3.0);
 

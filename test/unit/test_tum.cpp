@@ -244,6 +244,7 @@ TEST(TumDataset, LoadsBgrColourAndDepthInMetres) {
   EXPECT_FLOAT_EQ(f.depth.at<float>(1, 2), 1.5f);
   EXPECT_EQ(f.depth.at<float>(2, 3), 0.0f);
   EXPECT_DOUBLE_EQ(f.stamp, 10.033333);  // the colour stamp
+  EXPECT_DOUBLE_EQ(f.depth_stamp, 10.038);
   EXPECT_THROW(dataset.loadFrame(2), std::out_of_range);
 }
 

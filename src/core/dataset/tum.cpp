@@ -224,6 +224,7 @@ Frame TumDataset::loadFrame(std::size_t i) const {
   Frame frame;
   frame.camera = camera_;
   frame.stamp = a.rgb.stamp;
+  frame.depth_stamp = a.depth.stamp;
   frame.order = ColorOrder::kBgr;
   frame.color = cv::imread(color_path, cv::IMREAD_COLOR);  // 8-bit BGR whatever the file holds
   if (frame.color.empty()) throw std::runtime_error("cannot load colour image " + color_path);

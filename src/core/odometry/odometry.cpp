@@ -10,6 +10,7 @@
 #include <tbb/task_arena.h>
 
 #include "acvo/covariance.hpp"
+#include "acvo/depth.hpp"
 
 namespace acvo {
 
@@ -64,6 +65,20 @@ std::string percent(double fraction) {
   out << 100.0 * fraction << "%";
   return out.str();
 }
+
+// An upper bound of the image motion `moved` causes, in pixels: its rotation's at the image's
+// corner and its translation's at `nearest` metres.
+double largestPixelShift(const Eigen::Isometry3d& moved, const Camera& c, double nearest) {
+  const double corner2 =
+      0.25 * ((c.width / c.fx) * (c.width / c.fx) + (c.height / c.fy) * (c.height / c.fy));
+  const double angle = logSO3(moved.linear()).norm();
+  return std::max(c.fx, c.fy) *
+         (angle * (1.0 + corner2) + moved.translation().norm() / std::max(nearest, 0.1));
+}
+
+// A depth moved by less than this many pixels is left as it is (TUM fr3's streams are
+// synchronised to tens of microseconds).
+constexpr double kSyncMinShift = 0.1;
 
 double rotationDeg(const Eigen::Isometry3d& T) {
   return logSE3(T).head<3>().norm() * 180.0 / M_PI;
@@ -213,7 +228,7 @@ OdometryResult Odometry::process(const Frame& frame,
     r.message = why;
     return r;
   }
-  const std::shared_ptr<PreparedCloud> current = buildCloud(frame, r);
+  const std::shared_ptr<PreparedCloud> current = buildCloud(depthAtColourTime(frame, r), r);
   if (!keyframe_) {
     start(r, current);
     return r;
@@ -231,6 +246,21 @@ OdometryResult Odometry::process(const Frame& frame,
     tracked(r, reg, current);
   }
   return r;
+}
+
+Frame Odometry::depthAtColourTime(const Frame& frame, OdometryResult& r) const {
+  const double delay = frame.depth_stamp != 0.0 ? frame.stamp - frame.depth_stamp : 0.0;
+  r.depth_delay = delay;
+  // The motion over the delay, as the last frame-to-frame motion says (the colour's stamps
+  // measure both); unknown until two frames were tracked.
+  if (!params_.odometry.sync_depth || delay == 0.0 || !(velocity_interval_ > 0.0)) return frame;
+  const Eigen::Isometry3d moved = expSE3(logSE3(velocity_) * (delay / velocity_interval_));
+  if (largestPixelShift(moved, frame.camera, params_.selection.min_depth) < kSyncMinShift)
+    return frame;
+  Frame at_colour_time = frame;
+  at_colour_time.depth = depthSeenFrom(frame.depth, frame.camera, moved);
+  r.depth_synced = true;
+  return at_colour_time;
 }
 
 std::shared_ptr<PreparedCloud> Odometry::buildCloud(const Frame& frame, OdometryResult& r) {
