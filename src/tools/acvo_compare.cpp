@@ -151,6 +151,9 @@ class Method {
   virtual ~Method() = default;
   virtual bool process(const acvo::Frame& frame) = 0;
   virtual const Eigen::Isometry3d& pose() const = 0;
+  // Its poses are the depth camera's, at the depth images' stamps (a method of depth alone);
+  // otherwise at the colour images' (the stamps acvo's poses carry).
+  virtual bool depthOnly() const { return false; }
 };
 
 class AcvoMethod : public Method {
@@ -172,12 +175,14 @@ class PeerMethod : public Method {
  public:
   PeerMethod(const acvo::peers::PeerSetup& setup, const acvo::Camera& camera,
              const Eigen::Isometry3d& start)
-      : peer_(setup, camera, start) {}
+      : peer_(setup, camera, start), depth_only_(setup.kind == acvo::peers::PeerKind::kIcp) {}
   bool process(const acvo::Frame& frame) override { return peer_.process(frame); }
   const Eigen::Isometry3d& pose() const override { return peer_.pose(); }
+  bool depthOnly() const override { return depth_only_; }
 
  private:
   acvo::peers::PeerOdometry peer_;
+  bool depth_only_;
 };
 
 // What one row runs: its row and how to make a fresh method for each run.
@@ -269,7 +274,8 @@ void runOnce(std::vector<Entry>& entries, const std::vector<acvo::Frame>& frames
       if (!record) continue;
       Row& row = entries[j].row;
       if (!ok && i > 0) ++row.lost;
-      const auto& stamp = data.frames()[index[i]].rgb;
+      const auto& frame = data.frames()[index[i]];
+      const auto& stamp = methods[j]->depthOnly() ? frame.depth : frame.rgb;
       row.trajectory.push_back({stamp.stamp_text, stamp.stamp, methods[j]->pose()});
     }
   }

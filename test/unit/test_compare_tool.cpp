@@ -188,6 +188,34 @@ TEST_F(CompareTool, StrideUsesEveryKthFrame) {
   EXPECT_EQ(runTool("acvo_compare", "'" + (dir_ / "room").string() + "' --stride 0", out), 2);
 }
 
+// Colour taken 10 ms after the depth: acvo's poses carry the colour's stamps, ICPOdometry's (of
+// depth alone) the depth's; each is evaluated against the truth at its own stamps.
+TEST_F(CompareTool, APoseOfDepthAloneCarriesTheDepthsStamp) {
+  const fs::path data = dir_ / "colour_later", out = dir_ / "later.txt",
+                 traj = dir_ / "traj_later";
+  fs::create_directories(traj);
+  ASSERT_EQ(runTool("acvo_synth",
+                    "'" + data.string() + "' --frames 12 --width 160 --height 120 --colour-delay 0.01",
+                    dir_ / "synth_later.log"),
+            0);
+  ASSERT_EQ(runTool("acvo_compare",
+                    "'" + data.string() + "' --methods acvo,icp --peer-max-depth 10 --trajectories '" +
+                        traj.string() + "'",
+                    out),
+            0)
+      << readText(out);
+  const auto assoc = words(data / "associations.txt");
+  const auto acvo = words(traj / "colour_later-acvo.txt");
+  const auto icp = words(traj / "colour_later-icp-10m.txt");
+  ASSERT_EQ(assoc.size(), 12u);
+  ASSERT_EQ(acvo.size(), 12u);
+  ASSERT_EQ(icp.size(), 12u);
+  for (std::size_t i = 0; i < assoc.size(); ++i) {
+    EXPECT_EQ(acvo[i][0], assoc[i][0]) << i;  // the colour's stamp
+    EXPECT_EQ(icp[i][0], assoc[i][2]) << i;   // the depth's
+  }
+}
+
 TEST_F(CompareTool, BadArgumentsExitWithStatusTwo) {
   const fs::path out = dir_ / "bad.txt";
   const std::string room = "'" + (dir_ / "room").string() + "'";
