@@ -60,7 +60,9 @@ struct OdometryResult {
   // whether the depth was moved over it (OdometryParams::sync_depth, a velocity known).
   double depth_delay = 0.0;
   bool depth_synced = false;
-  double ms_cloud = 0.0;  // building this frame's cloud (selection + labels + self-kernel)
+  // building this frame's cloud (the depth moved to the colour's time, selection, labels,
+  // self-kernel)
+  double ms_cloud = 0.0;
   // of which: search grids + self-kernel pairs (a keyframe's grids when it became one)
   double ms_prepare = 0.0;
   double ms_registration = 0.0;  // the solver (both registrations when it fell back)
@@ -157,6 +159,7 @@ class Odometry {
   // The steps of process(), in order.
   // The frame with its depth moved to the colour's time when they differ (sync_depth).
   Frame depthAtColourTime(const Frame& frame, OdometryResult& r) const;
+  // The cloud of the frame at its colour's time.
   std::shared_ptr<PreparedCloud> buildCloud(const Frame& frame, OdometryResult& r);
   void start(OdometryResult& r, const std::shared_ptr<PreparedCloud>& current);
   // To the keyframe from the prior, then (lost) to the last tracked frame; fills r's solver

@@ -102,7 +102,7 @@ int main(int argc, char** argv) {
       stats << "frame,stamp,tracking,status,points,fixed_points,iterations,ell,ell_at_bound,nnz,"
                "inner_product,matched_fraction,ms_selection,ms_labels,ms_prepare,ms_cloud,ms_"
                "neighbours,ms_step,ms_ell,"
-               "ms_registration,ms_frame,rss_kib,keyframe,new_keyframe\n";
+               "ms_registration,ms_frame,rss_kib,keyframe,new_keyframe,depth_delay_ms,depth_moved\n";
     }
 
     acvo::Odometry odometry(params);
@@ -158,7 +158,8 @@ int main(int argc, char** argv) {
               << ',' << r.cloud_stats.ms_labels << ',' << r.ms_prepare << ',' << r.ms_cloud << ','
               << s.ms_neighbours << ',' << s.ms_step << ',' << s.ms_ell << ',' << r.ms_registration
               << ',' << ms << ',' << acvo::tools::residentKiB() << ',' << r.keyframe_index << ','
-              << int(r.new_keyframe) << '\n';
+              << int(r.new_keyframe) << ',' << 1e3 * r.depth_delay << ',' << int(r.depth_synced)
+              << '\n';
       }
       if (progress) {
         std::fprintf(stderr, "\racvo_tum: frame %ld/%ld  %3d it  %6.1f ms  %s    ", k - first + 1,

@@ -84,8 +84,7 @@ cv::Mat depthSeenFrom(const cv::Mat& depth_m, const Camera& camera,
       if (!(pu > -0.5f && pv > -0.5f && pu < float(depth_m.cols) - 0.5f &&
             pv < float(depth_m.rows) - 0.5f))
         continue;
-      // Rounded to the nearest pixel (both are above -0.5: truncation is the floor).
-      float& o = out.at<float>(int(pv + 0.5f), int(pu + 0.5f));
+      float& o = out.at<float>(cvRound(pv), cvRound(pu));  // the nearest pixel
       if (o == 0.0f || p.z() < o) o = p.z();  // the nearest surface hides the others
     }
   }

@@ -228,7 +228,7 @@ OdometryResult Odometry::process(const Frame& frame,
     r.message = why;
     return r;
   }
-  const std::shared_ptr<PreparedCloud> current = buildCloud(depthAtColourTime(frame, r), r);
+  const std::shared_ptr<PreparedCloud> current = buildCloud(frame, r);
   if (!keyframe_) {
     start(r, current);
     return r;
@@ -270,8 +270,9 @@ std::shared_ptr<PreparedCloud> Odometry::buildCloud(const Frame& frame, Odometry
   // Frame to frame, every frame becomes the reference: its search grids are built with it.
   // With keyframes, only when it becomes one (asReference).
   const bool every_frame_a_reference = params_.odometry.reference == Reference::kPreviousFrame;
+  const Frame at_colour_time = depthAtColourTime(frame, r);
   arena_->arena.execute([&] {
-    current = engine_->prepare(buildLabelledCloud(frame, params_.selection, &r.cloud_stats),
+    current = engine_->prepare(buildLabelledCloud(at_colour_time, params_.selection, &r.cloud_stats),
                                every_frame_a_reference);
   });
   r.ms_cloud = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
