@@ -161,7 +161,7 @@ TEST(DepthSeenFrom, AgreesWithOpenCVsRegisterDepthOnARealFrame) {
   cv::Mat theirs;
   cv::rgbd::registerDepth(K, K, cv::Mat::zeros(5, 1, CV_64F), Rt, nan_holes, frame.depth.size(),
                           theirs, false);
-  theirs.setTo(0.0f, theirs != theirs);
+  cv::patchNaNs(theirs, 0.0);
   int both = 0, agree = 0, only_one = 0;
   for (int v = 0; v < ours.rows; ++v) {
     for (int u = 0; u < ours.cols; ++u) {
