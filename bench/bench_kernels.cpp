@@ -1,5 +1,6 @@
 // acvo_bench_kernels: Google Benchmark timings of each stage of one registration, on one pair
-// of real frames (see frame_pair.hpp): pixel selection, cloud building; for the default engine
+// of real frames (see frame_pair.hpp): pixel selection, cloud building, the depth moved to the
+// colour's time; for the default engine
 // a reference's search grids, the kernel pass of a level (fresh and with warm candidate lists),
 // the last level's direct terms and a whole registration; for the paper's engine the cloud preparation (search grid and
 // self-kernel pairs), its kernel pass, the step-size sums, the self-kernel sums and a whole
@@ -24,6 +25,7 @@
 #include <tbb/task_arena.h>
 #include <opencv2/imgproc.hpp>
 
+#include "acvo/depth.hpp"
 #include "acvo/labelled_cloud.hpp"
 #include "acvo/point_selector.hpp"
 #include "frame_pair.hpp"
@@ -100,6 +102,21 @@ void BM_BuildCloud(benchmark::State& state) {
   state.counters["points"] = double(points);
 }
 BENCHMARK(BM_BuildCloud)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The depth moved to the colour's time (odometry.sync_depth): 10 ms of the frames' motion.
+void BM_DepthSeenFrom(benchmark::State& state) {
+  const acvo::Frame& f = g_pair->moving_frame;
+  const Eigen::Isometry3d moved =
+      acvo::expSE3(acvo::logSE3(g_pair->aligned) * (0.010 * 30.0));  // frames 1/30 s apart
+  std::size_t landed = 0;
+  for (auto _ : state) {
+    const cv::Mat d = acvo::depthSeenFrom(f.depth, f.camera, moved);
+    landed = std::size_t(cv::countNonZero(d));
+    benchmark::DoNotOptimize(d.data);
+  }
+  state.counters["pixels"] = double(landed);
+}
+BENCHMARK(BM_DepthSeenFrom)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_PrepareReference(benchmark::State& state) {
   inArena([&] {

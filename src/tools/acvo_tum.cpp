@@ -102,7 +102,8 @@ int main(int argc, char** argv) {
       stats << "frame,stamp,tracking,status,points,fixed_points,iterations,ell,ell_at_bound,nnz,"
                "inner_product,matched_fraction,ms_selection,ms_labels,ms_prepare,ms_cloud,ms_"
                "neighbours,ms_step,ms_ell,"
-               "ms_registration,ms_frame,rss_kib,keyframe,new_keyframe,depth_delay_ms,depth_moved\n";
+               "ms_registration,ms_frame,rss_kib,keyframe,new_keyframe,depth_delay_ms,"
+               "depth_moved\n";
     }
 
     acvo::Odometry odometry(params);

@@ -195,11 +195,13 @@ TEST_F(CompareTool, APoseOfDepthAloneCarriesTheDepthsStamp) {
                  traj = dir_ / "traj_later";
   fs::create_directories(traj);
   ASSERT_EQ(runTool("acvo_synth",
-                    "'" + data.string() + "' --frames 12 --width 160 --height 120 --colour-delay 0.01",
+                    "'" + data.string() +
+                        "' --frames 12 --width 160 --height 120 --colour-delay 0.01",
                     dir_ / "synth_later.log"),
             0);
   ASSERT_EQ(runTool("acvo_compare",
-                    "'" + data.string() + "' --methods acvo,icp --peer-max-depth 10 --trajectories '" +
+                    "'" + data.string() +
+                        "' --methods acvo,icp --peer-max-depth 10 --trajectories '" +
                         traj.string() + "'",
                     out),
             0)

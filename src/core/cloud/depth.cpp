@@ -61,31 +61,50 @@ cv::Mat depthSeenFrom(const cv::Mat& depth_m, const Camera& camera,
   if (depth_m.type() != CV_32FC1 || depth_m.cols != camera.width || depth_m.rows != camera.height)
     throw std::invalid_argument("depthSeenFrom: expects CV_32FC1 metres of the camera's size");
   // The same forward projection as cv::rgbd::registerDepth (which also handles two cameras),
-  // written out because that took 6 ms per 640x480 frame (teddy200, one thread), most of a
-  // frame's registration: here the ray of each column and row is computed once, in float.
+  // written out because that took 6 ms per 640x480 frame (teddy200, one thread, with the holes
+  // turned to NaN and back), most of a frame's registration: here the ray of each column and
+  // row is computed once, in float, and the projection is vectorised (0.6 ms).
   const Eigen::Isometry3f to_moved = moved.inverse().cast<float>();
   const Eigen::Matrix3f R = to_moved.linear();
   const Eigen::Vector3f t = to_moved.translation();
   const float fx = float(camera.fx), fy = float(camera.fy), cx = float(camera.cx),
               cy = float(camera.cy);
-  std::vector<float> ray_x(std::size_t(depth_m.cols));
-  for (int u = 0; u < depth_m.cols; ++u) ray_x[std::size_t(u)] = (float(u) - cx) / fx;
+  const int cols = depth_m.cols, rows = depth_m.rows;
+  std::vector<float> ray_x(std::size_t(cols), 0.0f);
+  for (int u = 0; u < cols; ++u) ray_x[std::size_t(u)] = (float(u) - cx) / fx;
+  // Per row, first where every pixel lands (a loop without stores elsewhere, which the compiler
+  // vectorises), then the stores: -1 marks a pixel that lands nowhere.
+  std::vector<int> target(std::size_t(cols), -1);
+  std::vector<float> moved_z(std::size_t(cols), 0.0f);
   cv::Mat out(depth_m.size(), CV_32FC1, cv::Scalar(0.0f));
-  for (int v = 0; v < depth_m.rows; ++v) {
+  auto* o = out.ptr<float>(0);
+  const float u_max = float(cols) - 0.5f, v_max = float(rows) - 0.5f;
+  const float r00 = R(0, 0), r10 = R(1, 0), r20 = R(2, 0), tx = t.x(), ty = t.y(), tz = t.z();
+  for (int v = 0; v < rows; ++v) {
     const float* in = depth_m.ptr<float>(v);
-    const Eigen::Vector3f row = R.col(1) * ((float(v) - cy) / fy) + R.col(2);
-    for (int u = 0; u < depth_m.cols; ++u) {
-      const float z = in[u];
-      if (!(z > 0.0f)) continue;
-      const Eigen::Vector3f p = (R.col(0) * ray_x[std::size_t(u)] + row) * z + t;
-      if (!(p.z() > 0.0f)) continue;
-      const float inverse_z = 1.0f / p.z();
-      const float pu = fx * p.x() * inverse_z + cx, pv = fy * p.y() * inverse_z + cy;
-      if (!(pu > -0.5f && pv > -0.5f && pu < float(depth_m.cols) - 0.5f &&
-            pv < float(depth_m.rows) - 0.5f))
-        continue;
-      float& o = out.at<float>(cvRound(pv), cvRound(pu));  // the nearest pixel
-      if (o == 0.0f || p.z() < o) o = p.z();  // the nearest surface hides the others
+    const float y = (float(v) - cy) / fy;
+    const float r0 = R(0, 1) * y + R(0, 2), r1 = R(1, 1) * y + R(1, 2), r2 = R(2, 1) * y + R(2, 2);
+    int* row_target = target.data();
+    float* row_z = moved_z.data();
+    for (int u = 0; u < cols; ++u) {
+      const float z = in[u], x = ray_x[std::size_t(u)];
+      const float px = (r00 * x + r0) * z + tx, py = (r10 * x + r1) * z + ty,
+                  pz = (r20 * x + r2) * z + tz;
+      const float inverse_z = 1.0f / pz;
+      const float pu = fx * px * inverse_z + cx, pv = fy * py * inverse_z + cy;
+      const bool lands = (z > 0.0f) & (pz > 0.0f) & (pu > -0.5f) & (pv > -0.5f) & (pu < u_max) &
+                         (pv < v_max);
+      // Rounded to the nearest pixel; a pixel that lands nowhere is converted from 0, never
+      // from a value out of int's range.
+      const int pixel = int(std::floor(lands ? pv + 0.5f : 0.0f)) * cols +
+                        int(std::floor(lands ? pu + 0.5f : 0.0f));
+      row_target[u] = lands ? pixel : -1;
+      row_z[u] = pz;
+    }
+    for (int u = 0; u < cols; ++u) {
+      const int k = row_target[u];
+      if (k < 0) continue;
+      if (o[k] == 0.0f || row_z[u] < o[k]) o[k] = row_z[u];  // the nearest surface hides the rest
     }
   }
   return out;

@@ -272,8 +272,9 @@ std::shared_ptr<PreparedCloud> Odometry::buildCloud(const Frame& frame, Odometry
   const bool every_frame_a_reference = params_.odometry.reference == Reference::kPreviousFrame;
   const Frame at_colour_time = depthAtColourTime(frame, r);
   arena_->arena.execute([&] {
-    current = engine_->prepare(buildLabelledCloud(at_colour_time, params_.selection, &r.cloud_stats),
-                               every_frame_a_reference);
+    current =
+        engine_->prepare(buildLabelledCloud(at_colour_time, params_.selection, &r.cloud_stats),
+                         every_frame_a_reference);
   });
   r.ms_cloud = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
   r.moving_points = current->size();
