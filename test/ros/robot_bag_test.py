@@ -43,13 +43,12 @@ RATE_HZ = 10  # a 30 Hz camera's every third frame: the motion between frames is
 PLAY_RATE = 0.5
 CONFIG = os.path.join(os.path.dirname(os.path.realpath(__file__)), "test_params.yaml")
 # Worst error of a base pose relative to the first over the sequence (30 frames at 10 Hz,
-# 0.3 m/s, Kinect-like noise): measured 0.001661 m, 0.000565 rad (acvo.launch's defaults:
+# 0.3 m/s, Kinect-like noise): measured 0.002433 m, 0.000651 rad (acvo.launch's defaults:
 # robot_frames.test, freenect.launch, guess_bag.test's prior run) and 0.002433 m, 0.000705 rad
-# (realsense.launch) with `rostest --text acvo realsense_bag.test` (freenect_bag.test,
-# robot_frames.test, guess_bag.test; the [ MEASURED ] lines). The freenect bags stamp the depth
-# 4 ms after the colour, and their depth is moved by 4 ms of motion (odometry/sync_depth),
-# though both images are of one instant here: 0.002433 m, 0.000651 rad before that. They were
-# 0.0217 m, 0.0096 rad before the direct terms. The bounds are 2.9x and 2.8x the larger.
+# (realsense.launch), the same to the printed digits in four runs on 2026-11-26 with `rostest
+# --text acvo realsense_bag.test` (freenect_bag.test, robot_frames.test, guess_bag.test; the
+# [ MEASURED ] lines). They were 0.0217 m, 0.0096 rad before the direct terms. The bounds are
+# 2.9x and 2.8x the larger.
 TRANSLATION_TOLERANCE = 0.007  # m
 ROTATION_TOLERANCE = 0.002  # rad
 # Frames that must come out when the bag is played at PLAY_RATE with the launch files' default
