@@ -2,11 +2,11 @@
 #include <unistd.h>
 
 #include <chrono>
-#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <iostream>
 #include <limits>
+#include <stdexcept>
 #include <string>
 
 #include "synth/sequence.hpp"
@@ -103,11 +103,6 @@ int main(int argc, char** argv) {
       ->transform(size);
   if (const auto status = acvo::tools::parseCommandLine(app, argc, argv)) return *status;
   o.camera = acvo::synth::scaledDefaultCamera(width, height);
-  if (!(std::abs(o.colour_delay) * o.rate < 0.5)) {  // a usage error, before any file is made
-    std::cerr << "acvo_synth: --colour-delay " << o.colour_delay
-              << " is not under half a frame interval at --rate " << o.rate << "\n";
-    return 2;
-  }
 
   const bool show_progress = isatty(fileno(stderr));
   const auto started = std::chrono::steady_clock::now();
@@ -115,6 +110,10 @@ int main(int argc, char** argv) {
     acvo::synth::writeSequence(output, o, [&](int done, int total) {
       if (show_progress) std::cerr << "\racvo_synth: frame " << done << "/" << total << std::flush;
     });
+  } catch (const std::invalid_argument& e) {
+    // Options that do not go together (SequenceOptions' own check, before any file is made,
+    // e.g. --colour-delay over half a frame at --rate): a usage error, as a bad option is.
+    return acvo::tools::usageError(app, e.what());
   } catch (const std::exception& e) {
     if (show_progress) std::cerr << "\n";
     std::cerr << "acvo_synth: " << e.what() << "\n";
