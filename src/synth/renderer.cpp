@@ -30,6 +30,7 @@ SynthFrame finish(const Eigen::Isometry3d& pose, const RenderOptions& options, s
   frame.pose = pose;
   frame.camera = options.camera;
   frame.surface = exact.surface;
+  if (options.brightness != 1.0) colour *= options.brightness;
   if (options.noise) {
     frame.depth_m = degradeDepth(exact.depth, options.kinect, options.camera.depth_scale, seed);
     addColourNoise(colour, options.kinect.colour_sigma, seed);

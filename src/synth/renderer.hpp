@@ -34,6 +34,9 @@ struct RenderOptions {
   // image is the colour camera's; depth, surfaces and the pose stay the depth camera's.
   double colour_focal_ratio = 1.0;
   double colour_baseline = 0.0;  // m
+  // The colour camera's exposure: its image is the scene's colour times this (before the noise
+  // and the 8-bit conversion, which saturates), as a camera's auto exposure scales it.
+  double brightness = 1.0;
 
   bool colourRegistered() const { return colour_focal_ratio == 1.0 && colour_baseline == 0.0; }
   Camera colourCamera() const;                                        // intrinsics

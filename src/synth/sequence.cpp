@@ -32,6 +32,8 @@ const SequenceOptions& validated(const SequenceOptions& o) {
   // Less than half a frame either way keeps the stamps in order.
   if (!(std::abs(o.colour_delay) * o.rate < 0.5))
     throw std::invalid_argument("colour_delay must be under half a frame interval");
+  if (!(o.brightness_swing >= 0 && o.brightness_swing <= 0.9))
+    throw std::invalid_argument("brightness_swing must be within [0, 0.9]");
   return o;
 }
 
@@ -47,6 +49,7 @@ std::string describe(const SequenceOptions& o) {
       << o.colour_baseline << " m";
   }
   if (o.colour_delay != 0.0) s << ", colour taken " << o.colour_delay << " s after the depth";
+  if (o.brightness_swing != 0.0) s << ", brightness swinging by " << o.brightness_swing;
   return s.str();
 }
 
@@ -107,12 +110,23 @@ Eigen::Isometry3d SynthSequence::colourPose(int i) const {
   return motion_.poseAt(i / options_.rate + options_.colour_delay);
 }
 
+double SynthSequence::brightness(double t) const {
+  if (options_.brightness_swing == 0.0) return 1.0;
+  Rng rng(hashCombine(options_.seed, 11));
+  const double phase_a = 2.0 * M_PI * rng.uniform();
+  const double phase_b = 2.0 * M_PI * rng.uniform();
+  const double s = 0.6 * std::sin(2.0 * M_PI * t / 3.7 + phase_a) +
+                   0.4 * std::sin(2.0 * M_PI * t / 1.3 + phase_b);
+  return 1.0 + options_.brightness_swing * s;
+}
+
 SynthFrame SynthSequence::frame(int i) const {
   if (i < 0 || i >= size()) throw std::out_of_range("synthetic frame index out of range");
   const std::uint64_t noise_seed = hashCombine(hashCombine(options_.seed, 3), i);
-  const RenderOptions render_options = options_.renderOptions();
+  RenderOptions render_options = options_.renderOptions();
   // The frame of `pose` at time t, blurred over the shutter time centred on t.
   auto renderAt = [&](const Eigen::Isometry3d& pose, double t, std::uint64_t seed) {
+    render_options.brightness = brightness(t);
     if (!(options_.blur && options_.blur_samples > 1 && options_.exposure > 0))
       return render(scene_, pose, render_options, seed);
     std::vector<Eigen::Isometry3d> exposure;

@@ -40,6 +40,10 @@ struct SequenceOptions {
   // Colour captured colour_delay seconds after the depth (unsynchronised streams): rendered at
   // the pose of that time and stamped with it in rgb.txt and associations.txt.
   double colour_delay = 0.0;
+  // A camera's auto exposure: the colour's brightness at time t is 1 + brightness_swing s(t),
+  // s a smooth curve within [-1, 1] (SynthSequence::brightness), up to 3 brightness_swing per
+  // second. 0 = constant.
+  double brightness_swing = 0.0;
   Camera camera;                // TUM default intrinsics, 640x480, depth scale 5000
   double first_stamp = 1000.0;  // seconds; frame i is at first_stamp + i / rate
 
@@ -56,7 +60,8 @@ class SynthSequence {
  public:
   // Throws std::invalid_argument for bad options (frames < 0, rate <= 0, speed < 0,
   // invalid camera, blur_samples < 1, exposure outside [0, 1], colour_focal_ratio outside
-  // [0.5, 2], colour_baseline not within 1 m, colour_delay not under half a frame interval).
+  // [0.5, 2], colour_baseline not within 1 m, colour_delay not under half a frame interval,
+  // brightness_swing outside [0, 0.9]).
   explicit SynthSequence(const SequenceOptions& options);
 
   int size() const { return options_.frames; }
@@ -64,6 +69,9 @@ class SynthSequence {
   const std::vector<Eigen::Isometry3d>& poses() const { return poses_; }  // camera-to-world
   // Where frame i's colour was taken: poses()[i] unless options().colour_delay.
   Eigen::Isometry3d colourPose(int i) const;
+  // The colour's brightness factor at time t seconds after the first frame (1 unless
+  // options().brightness_swing): two sines of periods 3.7 and 1.3 s, phases from the seed.
+  double brightness(double t) const;
   const Scene& scene() const { return scene_; }
   const Motion& motion() const { return motion_; }
   const SequenceOptions& options() const { return options_; }

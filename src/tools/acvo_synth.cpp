@@ -92,6 +92,12 @@ int main(int argc, char** argv) {
       ->type_name("S")
       ->capture_default_str()
       ->transform(acvo::tools::numberIn(-0.1, 0.1, "within [-0.1, 0.1] s"));
+  app.add_option("--brightness-swing", o.brightness_swing,
+                 "a camera's auto exposure: the colour's brightness swings smoothly by up to "
+                 "this fraction either way (0.2: +-20%, up to 2% a frame at 30 Hz)")
+      ->type_name("A")
+      ->capture_default_str()
+      ->transform(acvo::tools::numberIn(0.0, 0.9, "within [0, 0.9]"));
   const auto size = acvo::tools::numberIn(8, 8192, "within [8, 8192] pixels");
   app.add_option("--width", width, "image width; the 640x480 intrinsics scale with the size")
       ->type_name("W")

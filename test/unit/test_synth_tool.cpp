@@ -1,8 +1,10 @@
 // acvo_synth end to end: a tiny sequence on disk, its lists, groundtruth and camera file,
 // determinism, an unregistered colour camera (and scripts/register_colour undoing it), colour
-// taken after the depth, and the errors for bad options.
+// taken after the depth, a swinging brightness, and the errors for bad options.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -206,6 +208,54 @@ TEST(SynthTool, ColourTakenLaterIsRenderedAndStampedAtItsOwnTime) {
             0.0);
 }
 
+// A camera's auto exposure (--brightness-swing): each colour image is the constant one times the
+// sequence's brightness at its time, which stays within 1 +- the swing, changes smoothly and
+// depends on the seed; the depth and the poses are as without it.
+TEST(SynthTool, BrightnessSwingScalesTheColourAlone) {
+  const fs::path a = test::tempDir("synth_tool_constant"),
+                 b = test::tempDir("synth_tool_swinging");
+  const std::string common = " --frames 3 --width 96 --height 72 --seed 4 --noise off";
+  ASSERT_EQ(runTool("'" + a.string() + "'" + common), 0);
+  ASSERT_EQ(runTool("'" + b.string() + "'" + common + " --brightness-swing 0.3"), 0);
+  EXPECT_EQ(readRows(a / "groundtruth.txt"), readRows(b / "groundtruth.txt"));
+  for (const auto& row : readRows(a / "depth.txt")) {
+    EXPECT_EQ(readBytes(a / row[1]), readBytes(b / row[1]));
+  }
+  EXPECT_NE(readBytes(b / "rgb.txt").find("brightness swinging by 0.3"), std::string::npos);
+
+  SequenceOptions o;
+  o.frames = 300;
+  o.noise = false;
+  o.brightness_swing = 0.3;
+  o.camera = scaledDefaultCamera(96, 72);
+  const SynthSequence seq(o);
+  double lo = 2.0, hi = 0.0, steepest = 0.0;
+  for (int i = 0; i < seq.size(); ++i) {
+    const double g = seq.brightness(i / o.rate);
+    lo = std::min(lo, g);
+    hi = std::max(hi, g);
+    if (i > 0) steepest = std::max(steepest, std::abs(g - seq.brightness((i - 1) / o.rate)));
+  }
+  // Over 10 s the curve reaches most of its range and never changes faster than 3x the swing
+  // per second.
+  EXPECT_GE(lo, 0.7);
+  EXPECT_LE(hi, 1.3);
+  EXPECT_GT(hi - lo, 0.4);
+  EXPECT_LE(steepest, 3.0 * 0.3 / o.rate);
+  SequenceOptions other = o;
+  other.seed = 5;
+  EXPECT_NE(SynthSequence(other).brightness(0.0), seq.brightness(0.0));
+  SequenceOptions constant = o;
+  constant.brightness_swing = 0.0;
+  EXPECT_EQ(SynthSequence(constant).brightness(1.0), 1.0);
+  // Frame 7's colour is the constant rendering times its brightness (to 8-bit rounding).
+  const SynthFrame f = seq.frame(7);
+  cv::Mat expected;
+  SynthSequence(constant).frame(7).bgr.convertTo(expected, CV_8UC3, seq.brightness(7 / o.rate));
+  EXPECT_LE(cv::norm(f.bgr, expected, cv::NORM_INF), 1.0);
+  EXPECT_NE(seq.brightness(7 / o.rate), 1.0);
+}
+
 // Mean absolute difference of two 8-bit colour images.
 double meanDifference(const fs::path& a, const fs::path& b) {
   const cv::Mat x = cv::imread(a.string()), y = cv::imread(b.string());
@@ -272,6 +322,7 @@ TEST(SynthTool, HelpAndBadOptions) {
   EXPECT_EQ(runTool(out + " --colour-focal-ratio 0.2"), 2);
   EXPECT_EQ(runTool(out + " --colour-baseline 2"), 2);
   EXPECT_EQ(runTool(out + " --colour-delay 0.02"), 2);  // over half a frame at 30 Hz
+  EXPECT_EQ(runTool(out + " --brightness-swing 1"), 2);
   EXPECT_EQ(runTool(out + " --colour red"), 2);  // unknown option
   EXPECT_FALSE(fs::exists(test::tempDir("synth_tool_bad") / "rgb.txt"));
   // A folder that cannot be created is a run-time failure, not a usage error.
