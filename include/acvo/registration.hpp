@@ -58,6 +58,9 @@ struct SolverResult {
   int ell_max_reductions = 0;    // times ell reached ell_max and the bound shrank
   double inner_product = 0.0;    // <f_X, h.f_Z> / (|f_X| |f_Z|), in [0, 1]
   int list_builds = 0;           // candidate-list rebuilds
+  // coarse_to_fine's photometric term: the moving frame's brightness against the reference's
+  // at the last iteration (its grey values are compared times this; 1 without the term).
+  double brightness_gain = 1.0;
   std::vector<IterationTrace> trace;
   // Time per stage, milliseconds.
   double ms_total = 0.0;

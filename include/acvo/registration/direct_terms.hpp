@@ -78,11 +78,28 @@ struct DirectSums {
   Vector6d g = Vector6d::Zero();
   int used = 0;        // residuals summed
   double scale = 0.0;  // their learned scale (grey levels; metres per metre^2 of depth)
+  double gain = 1.0;   // photometric: the brightness gain the residuals were measured with
 };
 
-// r_j = I_ref(pi(T z_j)) - I_moving(pixel_j) over the landed points.
+// r_j = I_ref(pi(T z_j)) - b I_moving(pixel_j) over the landed points, b the brightness gain
+// from the moving image to the reference: 1, or with `gain` brightnessGain of their grey values
+// at the landed points. A camera's auto exposure scales a frame's grey levels by a few percent
+// from frame to frame (DSO models it per frame, affine). A ratio of grey values hardly depends
+// on how well the points are aligned, where a regression of one image on the other would shrink
+// towards 0 while they are not; the median leaves out the points that another surface hides.
 DirectSums photometricSums(const DirectImages& reference, const DirectImages& moving_images,
-                           const LabelledCloud& moving, const std::vector<Landing>& landed);
+                           const LabelledCloud& moving, const std::vector<Landing>& landed,
+                           bool gain = false);
+
+// The median of reference / moving over (reference, moving) grey-value pairs that neither
+// image saturates (both under kSaturated) and whose moving value is at least kDark (a ratio of
+// noise below it). 1 when fewer than kMinGainPairs such pairs remain, or when the median is
+// outside [1 / kMaxGain, kMaxGain] (another scene, not another exposure).
+constexpr float kSaturated = 250.0f;
+constexpr float kDark = 10.0f;
+constexpr std::size_t kMinGainPairs = 30;
+constexpr double kMaxGain = 2.0;
+double brightnessGain(const std::vector<std::pair<float, float>>& grey_pairs);
 
 // r_j = n^T (T z_j - x) / z_j^2, x the reference's point at the pixel where T z_j projects and
 // n the normal of its depth there, over the landed points where the reference's surface does not

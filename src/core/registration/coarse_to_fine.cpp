@@ -42,7 +42,7 @@ struct LevelDirect {
 // the factor that took the kernel's sums to the terms' units.
 double addDirectTerms(const LevelSums& s, double ell, const LevelDirect& direct,
                       const CoarseToFineParams& p, const Eigen::Isometry3d& T, Matrix6d& H,
-                      Vector6d& g) {
+                      Vector6d& g, double& gain) {
   // The kernel's quadratic is sum a_ij (x_i - y)^T W (x_i - y) / 2 ell_j^2 but for the factor
   // ell^2 its sums leave out: divided by ell^2 and by the mean kernel mass of a matched point,
   // each matched point weighs as one position known to ell_j, the scale the terms below are in.
@@ -55,7 +55,9 @@ double addDirectTerms(const LevelSums& s, double ell, const LevelDirect& direct,
       landings(*direct.reference, *direct.moving, *direct.moving_cloud, T);
   if (p.photometric) {
     const DirectSums d =
-        photometricSums(*direct.reference, *direct.moving, *direct.moving_cloud, landed);
+        photometricSums(*direct.reference, *direct.moving, *direct.moving_cloud, landed,
+                        p.photometric_gain);
+    gain = d.gain;
     H += d.H;
     g += d.g;
   }
@@ -80,7 +82,7 @@ bool iterateLevel(LevelKernel& kernel, const LevelDirect& direct, double ell, do
     // covariance_scale was calibrated in).
     result.hessian = -s.H;
     if (direct.reference) {
-      const double to_units = addDirectTerms(s, ell, direct, p, T, H, g);
+      const double to_units = addDirectTerms(s, ell, direct, p, T, H, g, result.brightness_gain);
       if (to_units > 0.0) result.hessian = -H / to_units;
     }
     result.ms_neighbours += msSince(t0);

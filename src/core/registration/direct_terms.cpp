@@ -206,15 +206,34 @@ std::vector<Landing> landings(const DirectImages& reference, const DirectImages&
   return out;
 }
 
+double brightnessGain(const std::vector<std::pair<float, float>>& grey_pairs) {
+  std::vector<std::pair<double, double>> ratios;  // (reference / moving, weight 1)
+  ratios.reserve(grey_pairs.size());
+  for (const auto& [r, m] : grey_pairs) {
+    if (r < kSaturated && m < kSaturated && m >= kDark) ratios.emplace_back(r / m, 1.0);
+  }
+  if (ratios.size() < kMinGainPairs) return 1.0;
+  const double gain = weightedMedian(ratios);
+  return gain >= 1.0 / kMaxGain && gain <= kMaxGain ? gain : 1.0;
+}
+
 DirectSums photometricSums(const DirectImages& reference, const DirectImages& moving_images,
-                           const LabelledCloud& moving, const std::vector<Landing>& landed) {
+                           const LabelledCloud& moving, const std::vector<Landing>& landed,
+                           bool gain) {
   if (!reference.isReference() || moving_images.point_intensity.size() != moving.size()) return {};
   const Camera& cam = reference.camera;
+  std::vector<std::pair<float, float>> grey;  // (reference, moving) per landed point
+  grey.reserve(landed.size());
+  for (const Landing& l : landed) {
+    grey.emplace_back(bilinear(reference.intensity, l.u, l.v),
+                      moving_images.point_intensity[l.j]);
+  }
+  const double b = gain ? brightnessGain(grey) : 1.0;
   std::vector<Residual> residuals;
   residuals.reserve(landed.size());
-  for (const Landing& l : landed) {
-    const double r = double(bilinear(reference.intensity, l.u, l.v)) -
-                     double(moving_images.point_intensity[l.j]);
+  for (std::size_t k = 0; k < landed.size(); ++k) {
+    const Landing& l = landed[k];
+    const double r = double(grey[k].first) - b * double(grey[k].second);
     const Eigen::Vector2d grad = bilinearGradient(reference.intensity, l.u, l.v);
     const double gu = grad.x(), gv = grad.y();
     // d r / d y = [gu gv] d pi / d y; d y / d xi = [-hat(y), I], and (-hat(y))^T d = y x d.
@@ -225,7 +244,10 @@ DirectSums photometricSums(const DirectImages& reference, const DirectImages& mo
     q.J << l.y.cross(d), d;
     residuals.push_back(q);
   }
-  return sumsOf(residuals, kMinIntensityScale, kEdgePosition2, [](double) { return 1.0; });
+  DirectSums s =
+      sumsOf(residuals, kMinIntensityScale, kEdgePosition2, [](double) { return 1.0; });
+  s.gain = b;
+  return s;
 }
 
 DirectSums pointToPlaneSums(const DirectImages& reference, const std::vector<Landing>& landed,
