@@ -207,13 +207,16 @@ std::vector<Landing> landings(const DirectImages& reference, const DirectImages&
 }
 
 double brightnessGain(const std::vector<std::pair<float, float>>& grey_pairs) {
-  std::vector<std::pair<double, double>> ratios;  // (reference / moving, weight 1)
+  std::vector<float> ratios;  // reference / moving
   ratios.reserve(grey_pairs.size());
   for (const auto& [r, m] : grey_pairs) {
-    if (r < kSaturated && m < kSaturated && m >= kDark) ratios.emplace_back(r / m, 1.0);
+    if (r < kSaturated && m < kSaturated && m >= kDark) ratios.push_back(r / m);
   }
   if (ratios.size() < kMinGainPairs) return 1.0;
-  const double gain = weightedMedian(ratios);
+  // The lower median (weightedMedian's answer for equal weights), by a partial sort.
+  const auto median = ratios.begin() + std::ptrdiff_t((ratios.size() - 1) / 2);
+  std::nth_element(ratios.begin(), median, ratios.end());
+  const double gain = *median;
   return gain >= 1.0 / kMaxGain && gain <= kMaxGain ? gain : 1.0;
 }
 
