@@ -31,6 +31,17 @@ SynthFrame finish(const Eigen::Isometry3d& pose, const RenderOptions& options, s
   frame.camera = options.camera;
   frame.surface = exact.surface;
   if (options.brightness != 1.0) colour *= options.brightness;
+  if (options.vignetting != 0.0) {
+    const Camera c = options.colourCamera();
+    for (int v = 0; v < colour.rows; ++v) {
+      auto* row = colour.ptr<cv::Vec3f>(v);
+      const double y = (v - c.cy) / c.fy;
+      for (int u = 0; u < colour.cols; ++u) {
+        const double x = (u - c.cx) / c.fx;
+        row[u] *= static_cast<float>(std::exp(options.vignetting * (x * x + y * y)));
+      }
+    }
+  }
   if (options.noise) {
     frame.depth_m = degradeDepth(exact.depth, options.kinect, options.camera.depth_scale, seed);
     addColourNoise(colour, options.kinect.colour_sigma, seed);

@@ -37,6 +37,10 @@ struct RenderOptions {
   // The colour camera's exposure: its image is the scene's colour times this (before the noise
   // and the 8-bit conversion, which saturates), as a camera's auto exposure scales it.
   double brightness = 1.0;
+  // The colour camera's vignetting: its image is also darkened by exp(vignetting rho) at each
+  // pixel, rho = ((u - cx) / fx)^2 + ((v - cy) / fy)^2 (a lens's falloff towards the corners;
+  // 0 = none, -1: 43% darker at a 640x480 TUM camera's corners).
+  double vignetting = 0.0;
 
   bool colourRegistered() const { return colour_focal_ratio == 1.0 && colour_baseline == 0.0; }
   Camera colourCamera() const;                                        // intrinsics

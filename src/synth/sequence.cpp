@@ -34,6 +34,8 @@ const SequenceOptions& validated(const SequenceOptions& o) {
     throw std::invalid_argument("colour_delay must be under half a frame interval");
   if (!(o.brightness_swing >= 0 && o.brightness_swing <= 0.9))
     throw std::invalid_argument("brightness_swing must be within [0, 0.9]");
+  if (!(o.vignetting >= -3 && o.vignetting <= 0))
+    throw std::invalid_argument("vignetting must be within [-3, 0]");
   return o;
 }
 
@@ -50,6 +52,7 @@ std::string describe(const SequenceOptions& o) {
   }
   if (o.colour_delay != 0.0) s << ", colour taken " << o.colour_delay << " s after the depth";
   if (o.brightness_swing != 0.0) s << ", brightness swinging by " << o.brightness_swing;
+  if (o.vignetting != 0.0) s << ", vignetting " << o.vignetting;
   return s.str();
 }
 
@@ -81,6 +84,7 @@ RenderOptions SequenceOptions::renderOptions() const {
   r.noise = noise;
   r.colour_focal_ratio = colour_focal_ratio;
   r.colour_baseline = colour_baseline;
+  r.vignetting = vignetting;
   return r;
 }
 

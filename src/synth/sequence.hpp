@@ -44,6 +44,8 @@ struct SequenceOptions {
   // s a smooth curve within [-1, 1] (SynthSequence::brightness), up to 3 brightness_swing per
   // second. 0 = constant.
   double brightness_swing = 0.0;
+  // The colour camera's vignetting (RenderOptions::vignetting; 0 = none).
+  double vignetting = 0.0;
   Camera camera;                // TUM default intrinsics, 640x480, depth scale 5000
   double first_stamp = 1000.0;  // seconds; frame i is at first_stamp + i / rate
 
@@ -61,7 +63,7 @@ class SynthSequence {
   // Throws std::invalid_argument for bad options (frames < 0, rate <= 0, speed < 0,
   // invalid camera, blur_samples < 1, exposure outside [0, 1], colour_focal_ratio outside
   // [0.5, 2], colour_baseline not within 1 m, colour_delay not under half a frame interval,
-  // brightness_swing outside [0, 0.9]).
+  // brightness_swing outside [0, 0.9], vignetting outside [-3, 0]).
   explicit SynthSequence(const SequenceOptions& options);
 
   int size() const { return options_.frames; }

@@ -1,6 +1,6 @@
 // acvo_synth end to end: a tiny sequence on disk, its lists, groundtruth and camera file,
 // determinism, an unregistered colour camera (and scripts/register_colour undoing it), colour
-// taken after the depth, a swinging brightness, and the errors for bad options.
+// taken after the depth, a swinging brightness, vignetting, and the errors for bad options.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -256,6 +256,44 @@ TEST(SynthTool, BrightnessSwingScalesTheColourAlone) {
   EXPECT_NE(seq.brightness(7 / o.rate), 1.0);
 }
 
+// A lens's vignetting (--vignetting V): each pixel's colour is the plain one times
+// exp(V rho), rho its squared distance from the principal point in focal lengths; the depth as
+// without it.
+TEST(SynthTool, VignettingDarkensTheColourTowardsTheCorners) {
+  const fs::path a = test::tempDir("synth_tool_no_vignetting"),
+                 b = test::tempDir("synth_tool_vignetting");
+  const std::string common = " --frames 2 --width 96 --height 72 --seed 4 --noise off";
+  ASSERT_EQ(runTool("'" + a.string() + "'" + common), 0);
+  ASSERT_EQ(runTool("'" + b.string() + "'" + common + " --vignetting -1"), 0);
+  for (const auto& row : readRows(a / "depth.txt")) {
+    EXPECT_EQ(readBytes(a / row[1]), readBytes(b / row[1]));
+  }
+  EXPECT_NE(readBytes(b / "rgb.txt").find("vignetting -1"), std::string::npos);
+  const auto rows = readRows(a / "rgb.txt");
+  const cv::Mat plain = cv::imread((a / rows[0][1]).string());
+  const cv::Mat dark = cv::imread((b / rows[0][1]).string());
+  ASSERT_FALSE(plain.empty());
+  ASSERT_EQ(plain.size(), dark.size());
+  const Camera c = scaledDefaultCamera(96, 72);
+  double worst = 0.0;
+  for (int v = 0; v < plain.rows; ++v) {
+    for (int u = 0; u < plain.cols; ++u) {
+      const double x = (u - c.cx) / c.fx, y = (v - c.cy) / c.fy;
+      const double factor = std::exp(-(x * x + y * y));
+      for (int k = 0; k < 3; ++k) {
+        const double expected = factor * plain.at<cv::Vec3b>(v, u)[k];
+        worst = std::max(worst, std::abs(dark.at<cv::Vec3b>(v, u)[k] - expected));
+      }
+    }
+  }
+  EXPECT_LE(worst, 1.0);  // both rounded to 8 bits from the same float colour
+  // A corner is darker than the centre by the factor there (0.57 for this camera).
+  const cv::Point corner(0, 0);
+  const double x = -c.cx / c.fx, y = -c.cy / c.fy;
+  EXPECT_LT(std::exp(-(x * x + y * y)), 0.6);
+  EXPECT_LT(cv::norm(dark.at<cv::Vec3b>(corner)), cv::norm(plain.at<cv::Vec3b>(corner)) + 1e-9);
+}
+
 // Mean absolute difference of two 8-bit colour images.
 double meanDifference(const fs::path& a, const fs::path& b) {
   const cv::Mat x = cv::imread(a.string()), y = cv::imread(b.string());
@@ -323,6 +361,7 @@ TEST(SynthTool, HelpAndBadOptions) {
   EXPECT_EQ(runTool(out + " --colour-baseline 2"), 2);
   EXPECT_EQ(runTool(out + " --colour-delay 0.02"), 2);  // over half a frame at 30 Hz
   EXPECT_EQ(runTool(out + " --brightness-swing 1"), 2);
+  EXPECT_EQ(runTool(out + " --vignetting 0.5"), 2);
   EXPECT_EQ(runTool(out + " --colour red"), 2);  // unknown option
   EXPECT_FALSE(fs::exists(test::tempDir("synth_tool_bad") / "rgb.txt"));
   // A folder that cannot be created is a run-time failure, not a usage error.
