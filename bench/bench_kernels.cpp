@@ -176,7 +176,8 @@ void BM_DirectTerms(benchmark::State& state) {
         g_pair->fixed->images, g_pair->moving->images, g_pair->moving->cloud, g_pair->aligned);
     const acvo::DirectSums a = acvo::photometricSums(g_pair->fixed->images, g_pair->moving->images,
                                                      g_pair->moving->cloud, landed,
-                                                     g_pair->params.coarse_to_fine.photometric_gain);
+                                                     g_pair->params.coarse_to_fine.photometric_gain,
+                                                     g_pair->params.coarse_to_fine.photometric_vignetting);
     const acvo::DirectSums b = acvo::pointToPlaneSums(
         g_pair->fixed->images, landed, g_pair->params.coarse_to_fine.depth_noise);
     used = a.used + b.used;

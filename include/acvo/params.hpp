@@ -68,6 +68,9 @@ struct CoarseToFineParams {
   // sums over the points it compares) and compares grey values at that gain: a camera's auto
   // exposure changes the brightness from frame to frame. Off: the grey values as they are.
   bool photometric_gain = true;
+  // ... and the camera's vignetting, the darkening towards the image's corners that a point
+  // moving across the image sees (measured the same way, per registration).
+  bool photometric_vignetting = true;
   int min_points = 30;  // fewer points in either cloud -> status too_few_points
   // Registration covariance = covariance_scale * (-H)^-1, H the Gauss-Newton information.
   double covariance_scale = 3.0e-7;
@@ -199,6 +202,7 @@ void visitParams(Params_& p, Visitor&& visit) {
   visit("coarse_to_fine", "photometric", c.photometric);
   visit("coarse_to_fine", "point_to_plane", c.point_to_plane);
   visit("coarse_to_fine", "photometric_gain", c.photometric_gain);
+  visit("coarse_to_fine", "photometric_vignetting", c.photometric_vignetting);
   visit("coarse_to_fine", "min_points", c.min_points);
   visit("coarse_to_fine", "covariance_scale", c.covariance_scale);
   auto& a = p.paper;

@@ -61,6 +61,9 @@ struct SolverResult {
   // coarse_to_fine's photometric term: the moving frame's brightness against the reference's
   // at the last iteration (its grey values are compared times this; 1 without the term).
   double brightness_gain = 1.0;
+  // ... and the vignetting it measured: exp(vignetting rho) the camera's falloff towards the
+  // corners, rho the squared distance from the principal point in focal lengths (0 without).
+  double vignetting = 0.0;
   std::vector<IterationTrace> trace;
   // Time per stage, milliseconds.
   double ms_total = 0.0;

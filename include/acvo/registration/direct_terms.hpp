@@ -13,6 +13,7 @@
 // edge's position is known) and Huber's weight beyond 2 standard deviations.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -71,6 +72,18 @@ std::vector<Landing> landings(const DirectImages& reference, const DirectImages&
 // pairs, which must not be empty. The terms' learned scales are weighted medians.
 double weightedMedian(std::vector<std::pair<double, double>>& pairs);
 
+// How a point's grey value in the moving image compares with the reference's where it lands:
+// I_ref(q) = gain exp(vignetting (rho(q) - rho(p))) I_moving(p), for a point seen at pixel p in
+// the moving image and at q in the reference, rho = ((u - cx) / fx)^2 + ((v - cy) / fy)^2.
+// A camera's auto exposure sets the gain from frame to frame; its lens darkens the image
+// towards the corners (vignetting < 0: exp(vignetting rho), the falloff of the camera itself,
+// the same in both images).
+struct Brightness {
+  double gain = 1.0;
+  double vignetting = 0.0;
+  double at(double shift) const { return gain * std::exp(vignetting * shift); }
+};
+
 // Gauss-Newton sums of 1/2 sum rho(r_j / s) for a left perturbation xi = (omega, v) of T
 // (the step is H^-1 g), s the learned scale.
 struct DirectSums {
@@ -78,28 +91,51 @@ struct DirectSums {
   Vector6d g = Vector6d::Zero();
   int used = 0;        // residuals summed
   double scale = 0.0;  // their learned scale (grey levels; metres per metre^2 of depth)
-  double gain = 1.0;   // photometric: the brightness gain the residuals were measured with
+  Brightness brightness;  // photometric: the brightness the residuals were measured at
 };
 
-// r_j = I_ref(pi(T z_j)) - b I_moving(pixel_j) over the landed points, b the brightness gain
-// from the moving image to the reference: 1, or with `gain` brightnessGain of their grey values
-// at the landed points. A camera's auto exposure scales a frame's grey levels by a few percent
-// from frame to frame (DSO models it per frame, affine). A ratio of grey values hardly depends
-// on how well the points are aligned, where a regression of one image on the other would shrink
-// towards 0 while they are not; the median leaves out the points that another surface hides.
+// A landed point's grey values as brightnessOf reads them.
+struct GreyPair {
+  float reference = 0.0f;  // I_ref(q)
+  float moving = 0.0f;     // I_moving(p)
+  float shift = 0.0f;      // rho(q) - rho(p)
+  float flat = 1.0f;       // 1 / (1 + |grad I_ref(q)|^2 / kFlatGradient^2)
+};
+
+// r_j = I_ref(pi(T z_j)) - B_j I_moving(pixel_j) over the landed points, B_j the brightness
+// from the moving image to the reference at that point: 1, or brightnessOf their grey values
+// (`gain`, `vignetting`). DSO models the same (an affine brightness per frame, a vignetting
+// calibrated offline); here both are measured at every iteration from the points compared.
 DirectSums photometricSums(const DirectImages& reference, const DirectImages& moving_images,
                            const LabelledCloud& moving, const std::vector<Landing>& landed,
-                           bool gain = false);
+                           bool gain = false, bool vignetting = false);
 
-// The median of reference / moving over (reference, moving) grey-value pairs that neither
-// image saturates (both under kSaturated) and whose moving value is at least kDark (a ratio of
-// noise below it). 1 when fewer than kMinGainPairs such pairs remain, or when the median is
-// outside [1 / kMaxGain, kMaxGain] (another scene, not another exposure).
+// The brightness of the pairs (at most kBrightnessPairs of them, evenly spaced) that neither image saturates (both under kSaturated) and that are
+// not dark (both at least kDark: a ratio of noise below it):
+//  - gain: the median of reference / moving. A ratio of grey values hardly depends on how well
+//    the points are aligned yet, where a regression of one image on the other would shrink
+//    towards 0 while they are not; the median leaves out the points another surface hides.
+//  - vignetting: the least-absolute-deviations slope of log(reference / moving) - log(gain)
+//    against the shift (the median of the pairs' slopes, weighted by |shift| and by flat: a
+//    grey value at an edge changes with a sub-pixel misalignment, one on a slope does not),
+//    within [kMinVignetting, kMaxVignetting]; then the gain again as the median of what the
+//    vignetting leaves, kBrightnessRounds times over (the least-absolute-deviations line by
+//    coordinate descent: pairs that another surface hides on one side only pull the first
+//    median, and rounds undo it).
+// Without either, its value as in Brightness{}. All of it 1 and 0 when fewer than kMinGainPairs
+// pairs remain or when the gain is outside [1 / kMaxGain, kMaxGain] (another scene, not another
+// exposure).
 constexpr float kSaturated = 250.0f;
 constexpr float kDark = 10.0f;
 constexpr std::size_t kMinGainPairs = 30;
 constexpr double kMaxGain = 2.0;
-double brightnessGain(const std::vector<std::pair<float, float>>& grey_pairs);
+constexpr double kMinVignetting = -3.0, kMaxVignetting = 1.0;
+constexpr double kFlatGradient = 8.0;  // grey levels per pixel
+// At most this many pairs are read (every k-th of more): a median of a thousand is known to a
+// few hundredths of its spread, and reading every landed point cost 4% of a frame.
+constexpr std::size_t kBrightnessPairs = 1024;
+constexpr int kBrightnessRounds = 4;
+Brightness brightnessOf(const std::vector<GreyPair>& pairs, bool gain, bool vignetting);
 
 // r_j = n^T (T z_j - x) / z_j^2, x the reference's point at the pixel where T z_j projects and
 // n the normal of its depth there, over the landed points where the reference's surface does not

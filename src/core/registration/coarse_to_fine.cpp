@@ -42,7 +42,7 @@ struct LevelDirect {
 // the factor that took the kernel's sums to the terms' units.
 double addDirectTerms(const LevelSums& s, double ell, const LevelDirect& direct,
                       const CoarseToFineParams& p, const Eigen::Isometry3d& T, Matrix6d& H,
-                      Vector6d& g, double& gain) {
+                      Vector6d& g, Brightness& brightness) {
   // The kernel's quadratic is sum a_ij (x_i - y)^T W (x_i - y) / 2 ell_j^2 but for the factor
   // ell^2 its sums leave out: divided by ell^2 and by the mean kernel mass of a matched point,
   // each matched point weighs as one position known to ell_j, the scale the terms below are in.
@@ -56,8 +56,8 @@ double addDirectTerms(const LevelSums& s, double ell, const LevelDirect& direct,
   if (p.photometric) {
     const DirectSums d =
         photometricSums(*direct.reference, *direct.moving, *direct.moving_cloud, landed,
-                        p.photometric_gain);
-    gain = d.gain;
+                        p.photometric_gain, p.photometric_vignetting);
+    brightness = d.brightness;
     H += d.H;
     g += d.g;
   }
@@ -82,7 +82,10 @@ bool iterateLevel(LevelKernel& kernel, const LevelDirect& direct, double ell, do
     // covariance_scale was calibrated in).
     result.hessian = -s.H;
     if (direct.reference) {
-      const double to_units = addDirectTerms(s, ell, direct, p, T, H, g, result.brightness_gain);
+      Brightness brightness;
+      const double to_units = addDirectTerms(s, ell, direct, p, T, H, g, brightness);
+      result.brightness_gain = brightness.gain;
+      result.vignetting = brightness.vignetting;
       if (to_units > 0.0) result.hessian = -H / to_units;
     }
     result.ms_neighbours += msSince(t0);

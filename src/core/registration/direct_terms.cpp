@@ -206,50 +206,93 @@ std::vector<Landing> landings(const DirectImages& reference, const DirectImages&
   return out;
 }
 
-double brightnessGain(const std::vector<std::pair<float, float>>& grey_pairs) {
-  std::vector<float> ratios;  // reference / moving
-  ratios.reserve(grey_pairs.size());
-  for (const auto& [r, m] : grey_pairs) {
-    if (r < kSaturated && m < kSaturated && m >= kDark) ratios.push_back(r / m);
+Brightness brightnessOf(const std::vector<GreyPair>& pairs, bool gain, bool vignetting) {
+  struct Usable {
+    double log_ratio, shift, flat;
+  };
+  std::vector<Usable> usable;
+  usable.reserve(pairs.size());
+  const std::size_t stride =
+      std::max<std::size_t>(1, (pairs.size() + kBrightnessPairs - 1) / kBrightnessPairs);
+  for (std::size_t k = 0; k < pairs.size(); k += stride) {
+    const GreyPair& p = pairs[k];
+    if (p.reference < kSaturated && p.moving < kSaturated && p.reference >= kDark &&
+        p.moving >= kDark) {
+      usable.push_back({std::log(double(p.reference) / double(p.moving)), p.shift, p.flat});
+    }
   }
-  if (ratios.size() < kMinGainPairs) return 1.0;
-  // The lower median (weightedMedian's answer for equal weights), by a partial sort.
-  const auto median = ratios.begin() + std::ptrdiff_t((ratios.size() - 1) / 2);
-  std::nth_element(ratios.begin(), median, ratios.end());
-  const double gain = *median;
-  return gain >= 1.0 / kMaxGain && gain <= kMaxGain ? gain : 1.0;
+  if (usable.size() < kMinGainPairs || !(gain || vignetting)) return {};
+  // The lower median of log(ratio) - v shift (weightedMedian's answer for equal weights).
+  std::vector<double> rest(usable.size());
+  auto logGain = [&](double v) {
+    for (std::size_t k = 0; k < usable.size(); ++k) {
+      rest[k] = usable[k].log_ratio - v * usable[k].shift;
+    }
+    const auto median = rest.begin() + std::ptrdiff_t((rest.size() - 1) / 2);
+    std::nth_element(rest.begin(), median, rest.end());
+    return *median;
+  };
+  Brightness b;
+  double log_gain = gain ? logGain(0.0) : 0.0;
+  if (vignetting) {
+    std::vector<std::pair<double, double>> slopes;  // (slope, weight)
+    slopes.reserve(usable.size());
+    for (int round = 0; round < kBrightnessRounds; ++round) {
+      slopes.clear();
+      for (const Usable& u : usable) {
+        if (std::abs(u.shift) > 1e-6) {
+          slopes.emplace_back((u.log_ratio - log_gain) / u.shift, std::abs(u.shift) * u.flat);
+        }
+      }
+      if (slopes.size() < kMinGainPairs) break;
+      b.vignetting = std::clamp(weightedMedian(slopes), kMinVignetting, kMaxVignetting);
+      if (gain) log_gain = logGain(b.vignetting);
+    }
+  }
+  b.gain = std::exp(log_gain);
+  if (!(b.gain >= 1.0 / kMaxGain && b.gain <= kMaxGain)) return {};
+  return b;
 }
 
 DirectSums photometricSums(const DirectImages& reference, const DirectImages& moving_images,
                            const LabelledCloud& moving, const std::vector<Landing>& landed,
-                           bool gain) {
+                           bool gain, bool vignetting) {
   if (!reference.isReference() || moving_images.point_intensity.size() != moving.size()) return {};
   const Camera& cam = reference.camera;
-  std::vector<std::pair<float, float>> grey;  // (reference, moving) per landed point
-  grey.reserve(landed.size());
-  for (const Landing& l : landed) {
-    grey.emplace_back(bilinear(reference.intensity, l.u, l.v),
-                      moving_images.point_intensity[l.j]);
-  }
-  const double b = gain ? brightnessGain(grey) : 1.0;
-  std::vector<Residual> residuals;
-  residuals.reserve(landed.size());
+  auto rho = [&cam](double u, double v) {
+    const double x = (u - cam.cx) / cam.fx, y = (v - cam.cy) / cam.fy;
+    return x * x + y * y;
+  };
+  const bool pixels = moving.pixels.size() == moving.size();
+  std::vector<GreyPair> grey(landed.size());
+  std::vector<Residual> residuals(landed.size());
   for (std::size_t k = 0; k < landed.size(); ++k) {
     const Landing& l = landed[k];
-    const double r = double(grey[k].first) - b * double(grey[k].second);
     const Eigen::Vector2d grad = bilinearGradient(reference.intensity, l.u, l.v);
     const double gu = grad.x(), gv = grad.y();
     // d r / d y = [gu gv] d pi / d y; d y / d xi = [-hat(y), I], and (-hat(y))^T d = y x d.
     const double iz = 1.0 / l.y.z();
     const Eigen::Vector3d d(gu * cam.fx * iz, gv * cam.fy * iz,
                             -(gu * cam.fx * l.y.x() + gv * cam.fy * l.y.y()) * iz * iz);
-    Residual q{r, Vector6d(), gu * gu + gv * gv};
+    Residual& q = residuals[k];
+    q.say = gu * gu + gv * gv;
     q.J << l.y.cross(d), d;
-    residuals.push_back(q);
+    GreyPair& g = grey[k];
+    g.reference = bilinear(reference.intensity, l.u, l.v);
+    g.moving = moving_images.point_intensity[l.j];
+    if (pixels) {
+      const cv::Point& p = moving.pixels[l.j];
+      g.shift = float(rho(l.u, l.v) - rho(p.x, p.y));
+    }
+    g.flat = float(1.0 / (1.0 + q.say / (kFlatGradient * kFlatGradient)));
+  }
+  const Brightness b = brightnessOf(grey, gain, vignetting);
+  for (std::size_t k = 0; k < landed.size(); ++k) {
+    residuals[k].r = double(grey[k].reference) - b.at(grey[k].shift) * double(grey[k].moving);
   }
   DirectSums s =
       sumsOf(residuals, kMinIntensityScale, kEdgePosition2, [](double) { return 1.0; });
-  s.gain = b;
+  s.brightness = b;
   return s;
 }
 
