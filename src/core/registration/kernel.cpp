@@ -188,10 +188,8 @@ void CandidateLists::build(const Eigen::Isometry3d& T, float radius) {
         if (!((x - y).squaredNorm() < radius2)) return;
         const float label_d2 = (fx[std::size_t(i)] - gz[std::size_t(j)]).squaredNorm();
         if (!(label_d2 <= label_d2_max)) return;
-        const float cf = colorFactorOf(label_d2, k_.color_inv, k_.color_sigma2);
-        if (k_.sigma2 * cf < k_.sparsification) return;  // fails at any distance
         chunk.i.push_back(i);
-        chunk.color.push_back(cf);
+        chunk.color.push_back(label_d2);  // its colour factor below, for the chunk at once
         chunk.x.push_back(x.x());
         chunk.y.push_back(x.y());
         chunk.z.push_back(x.z());
@@ -200,6 +198,10 @@ void CandidateLists::build(const Eigen::Isometry3d& T, float radius) {
       longest = std::max(longest, chunk.end.back() - start);
       start = chunk.end.back();
     }
+    // The colour factors of the chunk's pairs from their label distances, vectorised (one
+    // std::exp per pair took 2-3% of a frame).
+    Eigen::Map<Eigen::ArrayXf> color(chunk.color.data(), Eigen::Index(chunk.color.size()));
+    color = k_.color_sigma2 * (color * -k_.color_inv).exp();
     if (chunk.scratch_d2.size() < longest) {
       chunk.scratch_d2.resize(longest);
       chunk.scratch_a.resize(longest);
