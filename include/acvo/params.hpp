@@ -64,9 +64,10 @@ struct CoarseToFineParams {
   // better than a Kinect's). Off: the kernel alone, as before them.
   bool photometric = true;
   bool point_to_plane = true;
-  // The photometric term measures each frame's brightness against the reference's (their grey
-  // sums over the points it compares) and compares grey values at that gain: a camera's auto
-  // exposure changes the brightness from frame to frame. Off: the grey values as they are.
+  // The photometric term measures each frame's brightness against the reference's (the median
+  // ratio of their grey values at the points it compares) and compares grey values at that
+  // gain: a camera's auto exposure changes the brightness from frame to frame. Off: the grey
+  // values as they are.
   bool photometric_gain = true;
   // ... and the camera's vignetting, the darkening towards the image's corners that a point
   // moving across the image sees (measured the same way, per registration).

@@ -81,7 +81,9 @@ double weightedMedian(std::vector<std::pair<double, double>>& pairs);
 struct Brightness {
   double gain = 1.0;
   double vignetting = 0.0;
-  double at(double shift) const { return gain * std::exp(vignetting * shift); }
+  double at(double shift) const {
+    return vignetting == 0.0 ? gain : gain * std::exp(vignetting * shift);
+  }
 };
 
 // Gauss-Newton sums of 1/2 sum rho(r_j / s) for a left perturbation xi = (omega, v) of T
@@ -110,8 +112,9 @@ DirectSums photometricSums(const DirectImages& reference, const DirectImages& mo
                            const LabelledCloud& moving, const std::vector<Landing>& landed,
                            bool gain = false, bool vignetting = false);
 
-// The brightness of the pairs (at most kBrightnessPairs of them, evenly spaced) that neither image saturates (both under kSaturated) and that are
-// not dark (both at least kDark: a ratio of noise below it):
+// The brightness of the pairs (at most kBrightnessPairs of them, evenly spaced) that neither
+// image saturates (both under kSaturated) and that are not dark (both at least kDark: a ratio
+// of noise below it):
 //  - gain: the median of reference / moving. A ratio of grey values hardly depends on how well
 //    the points are aligned yet, where a regression of one image on the other would shrink
 //    towards 0 while they are not; the median leaves out the points another surface hides.
@@ -122,9 +125,9 @@ DirectSums photometricSums(const DirectImages& reference, const DirectImages& mo
 //    vignetting leaves, kBrightnessRounds times over (the least-absolute-deviations line by
 //    coordinate descent: pairs that another surface hides on one side only pull the first
 //    median, and rounds undo it).
-// Without either, its value as in Brightness{}. All of it 1 and 0 when fewer than kMinGainPairs
-// pairs remain or when the gain is outside [1 / kMaxGain, kMaxGain] (another scene, not another
-// exposure).
+// What is not asked for stays as in Brightness{} (1, 0); both are 1 and 0 when fewer than
+// kMinGainPairs pairs remain or when the gain is outside [1 / kMaxGain, kMaxGain] (another
+// scene, not another exposure).
 constexpr float kSaturated = 250.0f;
 constexpr float kDark = 10.0f;
 constexpr std::size_t kMinGainPairs = 30;
