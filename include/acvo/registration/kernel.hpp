@@ -70,6 +70,14 @@ class VoxelGrid {
   // every point within `radius` of q (and a few more from the columns' corners).
   template <typename F>
   void forEachWithin(const Eigen::Vector3f& q, float radius, F&& f) const;
+  // The same box as runs of the grid's order: f(begin, end) for each column the box covers that
+  // has points in its z range, in the order forEachWithin visits them; index(k) and point(k)
+  // give the k-th point of that order.
+  template <typename F>
+  void forEachRun(const Eigen::Vector3f& q, float radius, F&& f) const;
+  int index(int k) const { return order_[std::size_t(k)]; }
+  const Eigen::Vector3f& point(int k) const { return points_[std::size_t(k)]; }
+  int size() const { return int(order_.size()); }
   // forEachWithin(q, cell()).
   template <typename F>
   void forEachCandidate(const Eigen::Vector3f& q, F&& f) const {
@@ -122,6 +130,7 @@ class CandidateLists {
     std::vector<float> color;  // sigma_c^2 exp(-|f_i - g_j|^2 / 2 l_c^2)
     std::vector<float> x, y, z;
     Eigen::ArrayXf scratch_d2, scratch_a;  // work buffers as long as the chunk's longest list
+    std::vector<int> near;  // build's work buffer: grid positions within reach of one point
   };
 
   // `grid` indexes the fixed cloud's points (any cell: queries cover their own radius).
@@ -146,9 +155,9 @@ class CandidateLists {
  private:
   void build(const Eigen::Isometry3d& T, float radius);
 
-  const LabelledCloud& fixed_;
   const LabelledCloud& moving_;
   const VoxelGrid& grid_;
+  std::vector<Label> grid_labels_;  // the fixed labels in the grid's order (read contiguously)
   KernelConstants k_;
   std::vector<float> search_scale_;
   std::vector<Chunk> chunks_;
@@ -166,6 +175,13 @@ LabelledCloud stridedSubset(const LabelledCloud& cloud, int count);
 // ---------------------------------------------------------------------------------------------
 template <typename F>
 void VoxelGrid::forEachWithin(const Eigen::Vector3f& q, float radius, F&& f) const {
+  forEachRun(q, radius, [&](int begin, int end) {
+    for (int k = begin; k < end; ++k) f(order_[std::size_t(k)], points_[std::size_t(k)]);
+  });
+}
+
+template <typename F>
+void VoxelGrid::forEachRun(const Eigen::Vector3f& q, float radius, F&& f) const {
   if (order_.empty()) return;
   // Column range in float first: a query far outside the grid, or not finite, would not fit an
   // int (undefined behaviour); NaN fails every comparison.
@@ -183,10 +199,10 @@ void VoxelGrid::forEachWithin(const Eigen::Vector3f& q, float radius, F&& f) con
       const int column = y * nx_ + x;
       const auto begin = z_.begin() + column_start_[std::size_t(column)];
       const auto end = z_.begin() + column_start_[std::size_t(column) + 1];
-      for (auto k = std::lower_bound(begin, end, z_lo); k != end && *k <= z_hi; ++k) {
-        const std::size_t at = std::size_t(k - z_.begin());
-        f(order_[at], points_[at]);
-      }
+      const auto first = std::lower_bound(begin, end, z_lo);
+      auto last = first;
+      while (last != end && *last <= z_hi) ++last;
+      if (last != first) f(int(first - z_.begin()), int(last - z_.begin()));
     }
   }
 }
