@@ -162,6 +162,8 @@ acvo::AcvoConfig toConfig(const acvo::Params& params, LostOdom lost_odom) {
   c.level_iterations = params.coarse_to_fine.level_iterations;
   c.photometric = params.coarse_to_fine.photometric;
   c.point_to_plane = params.coarse_to_fine.point_to_plane;
+  c.photometric_gain = params.coarse_to_fine.photometric_gain;
+  c.photometric_vignetting = params.coarse_to_fine.photometric_vignetting;
   c.paper_ell_policy = acvo::toString(params.paper.ell_policy);
   c.paper_ell_init = params.paper.ell_init;
   c.paper_ell_min = params.paper.ell_min;
@@ -169,6 +171,7 @@ acvo::AcvoConfig toConfig(const acvo::Params& params, LostOdom lost_odom) {
   c.paper_color_ell = params.paper.color_ell;
   c.paper_max_iterations = params.paper.max_iterations;
   c.initial_guess = acvo::toString(params.odometry.initial_guess);
+  c.sync_depth = params.odometry.sync_depth;
   c.lost_odom = toString(lost_odom);
   return c;
 }
@@ -185,6 +188,8 @@ acvo::Params fromConfig(const acvo::AcvoConfig& config, acvo::Params base) {
   base.coarse_to_fine.level_iterations = config.level_iterations;
   base.coarse_to_fine.photometric = config.photometric;
   base.coarse_to_fine.point_to_plane = config.point_to_plane;
+  base.coarse_to_fine.photometric_gain = config.photometric_gain;
+  base.coarse_to_fine.photometric_vignetting = config.photometric_vignetting;
   acvo::fromString(config.paper_ell_policy, base.paper.ell_policy);
   base.paper.ell_init = config.paper_ell_init;
   base.paper.ell_min = config.paper_ell_min;
@@ -192,6 +197,7 @@ acvo::Params fromConfig(const acvo::AcvoConfig& config, acvo::Params base) {
   base.paper.color_ell = config.paper_color_ell;
   base.paper.max_iterations = config.paper_max_iterations;
   acvo::fromString(config.initial_guess, base.odometry.initial_guess);
+  base.odometry.sync_depth = config.sync_depth;
   return base;
 }
 

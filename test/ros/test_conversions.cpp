@@ -549,6 +549,8 @@ TEST(RosParams, ReconfigureRoundTripsAndDescribesEveryParameter) {
   p.paper.color_ell = 0.25;
   p.coarse_to_fine.depth_noise = 0.001;
   p.coarse_to_fine.point_to_plane = false;
+  p.coarse_to_fine.photometric_vignetting = false;
+  p.odometry.sync_depth = false;
   p.odometry.initial_guess = acvo::InitialGuess::kIdentity;
   const acvo::AcvoConfig c = toConfig(p, LostOdom::kNone);
   EXPECT_EQ(c.lost_odom, "none");
