@@ -7,6 +7,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
 #include "acvo/frame.hpp"
@@ -29,6 +30,9 @@ struct LabelledCloud {
   cv::Mat gray;   // CV_8UC1
   cv::Mat depth;  // CV_32FC1 metres, 0 or NaN = none
   Camera camera;
+  // The camera's motion while its shutter was open, as predicted (identity: none known). A
+  // moving camera blurs the colour along each point's image motion over it.
+  Eigen::Isometry3d blur_motion = Eigen::Isometry3d::Identity();
 
   std::size_t size() const { return points.size(); }
   bool empty() const { return points.empty(); }

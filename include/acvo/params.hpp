@@ -72,6 +72,11 @@ struct CoarseToFineParams {
   // ... and the camera's vignetting, the darkening towards the image's corners that a point
   // moving across the image sees (measured the same way, per registration).
   bool photometric_vignetting = true;
+  // The camera's exposure time (s). A moving camera smears each colour edge along a point's
+  // image motion over it (predicted from the last frame's motion); a point whose depth changes
+  // surface within that smear has the other surface's colour and is left out of both direct
+  // terms. 0: the images are sharp (only the 4-neighbours' depth is checked).
+  double exposure_time = 0.016;
   int min_points = 30;  // fewer points in either cloud -> status too_few_points
   // Registration covariance = covariance_scale * (-H)^-1, H the Gauss-Newton information.
   double covariance_scale = 3.0e-7;
@@ -204,6 +209,7 @@ void visitParams(Params_& p, Visitor&& visit) {
   visit("coarse_to_fine", "point_to_plane", c.point_to_plane);
   visit("coarse_to_fine", "photometric_gain", c.photometric_gain);
   visit("coarse_to_fine", "photometric_vignetting", c.photometric_vignetting);
+  visit("coarse_to_fine", "exposure_time", c.exposure_time);
   visit("coarse_to_fine", "min_points", c.min_points);
   visit("coarse_to_fine", "covariance_scale", c.covariance_scale);
   auto& a = p.paper;

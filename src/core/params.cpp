@@ -176,6 +176,8 @@ std::string validate(const Params& p) {
   check(why, c.ell_depth_reference >= 0.0, "coarse_to_fine.ell_depth_reference",
         "must not be negative (0 = off)");
   check(why, c.depth_noise >= 0.0, "coarse_to_fine.depth_noise", "must not be negative (0 = off)");
+  check(why, c.exposure_time >= 0.0 && c.exposure_time <= 1.0, "coarse_to_fine.exposure_time",
+        "must be within [0, 1] s (0 = sharp images)");
   check(why, c.level_points > 0, "coarse_to_fine.level_points", "must be positive");
   check(why, c.level_iterations > 0, "coarse_to_fine.level_iterations", "must be positive");
   check(why, c.level_eps > 0.0, "coarse_to_fine.level_eps", "must be positive");

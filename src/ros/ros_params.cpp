@@ -164,6 +164,7 @@ acvo::AcvoConfig toConfig(const acvo::Params& params, LostOdom lost_odom) {
   c.point_to_plane = params.coarse_to_fine.point_to_plane;
   c.photometric_gain = params.coarse_to_fine.photometric_gain;
   c.photometric_vignetting = params.coarse_to_fine.photometric_vignetting;
+  c.exposure_time = params.coarse_to_fine.exposure_time;
   c.paper_ell_policy = acvo::toString(params.paper.ell_policy);
   c.paper_ell_init = params.paper.ell_init;
   c.paper_ell_min = params.paper.ell_min;
@@ -190,6 +191,7 @@ acvo::Params fromConfig(const acvo::AcvoConfig& config, acvo::Params base) {
   base.coarse_to_fine.point_to_plane = config.point_to_plane;
   base.coarse_to_fine.photometric_gain = config.photometric_gain;
   base.coarse_to_fine.photometric_vignetting = config.photometric_vignetting;
+  base.coarse_to_fine.exposure_time = config.exposure_time;
   acvo::fromString(config.paper_ell_policy, base.paper.ell_policy);
   base.paper.ell_init = config.paper_ell_init;
   base.paper.ell_min = config.paper_ell_min;

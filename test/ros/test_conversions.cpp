@@ -550,6 +550,7 @@ TEST(RosParams, ReconfigureRoundTripsAndDescribesEveryParameter) {
   p.coarse_to_fine.depth_noise = 0.001;
   p.coarse_to_fine.point_to_plane = false;
   p.coarse_to_fine.photometric_vignetting = false;
+  p.coarse_to_fine.exposure_time = 0.004;
   p.odometry.sync_depth = false;
   p.odometry.initial_guess = acvo::InitialGuess::kIdentity;
   const acvo::AcvoConfig c = toConfig(p, LostOdom::kNone);

@@ -338,6 +338,37 @@ TEST(DirectTerms, PointsOnADepthEdgeOrOccludedAreLeftOut) {
   EXPECT_EQ(pointToPlaneAt(ref, mov, c, back, 0.0).used, 0);
 }
 
+TEST(DirectTerms, PointsWhoseBlurCrossesADepthEdgeAreLeftOut) {
+  // The wall and box of the test above; points 4 px left of the edge (on the wall), 4 px right
+  // of it (on the box) and 10 px left of it.
+  LabelledCloud c;
+  c.width = 40;
+  c.height = 30;
+  c.camera = Camera{30.0, 30.0, 19.5, 14.5, 40, 30, 1.0};
+  c.gray = cv::Mat(30, 40, CV_8UC1, cv::Scalar(100));
+  c.depth = cv::Mat(30, 40, CV_32FC1, cv::Scalar(2.0f));
+  c.depth.colRange(20, 40).setTo(1.0f);
+  for (const cv::Point px : {cv::Point(16, 15), cv::Point(24, 15), cv::Point(10, 15)}) {
+    c.pixels.push_back(px);
+    c.points.push_back(c.camera.backProject(px.x, px.y, c.depth.at<float>(px)).cast<float>());
+  }
+  auto kept = [&c](const Eigen::Vector3d& shift) {
+    c.blur_motion = Eigen::Translation3d(shift) * Eigen::Isometry3d::Identity();
+    const DirectImages images = directImages(c);
+    return std::vector<int>(images.one_surface.begin(), images.one_surface.end());
+  };
+  // No blur known: each point's 4-neighbours are one surface.
+  EXPECT_EQ(kept(Eigen::Vector3d::Zero()), (std::vector<int>{1, 1, 1}));
+  // Sideways by 0.4 m (wall points move 6 px, box points 12 px): each smear reaches half its
+  // length and a pixel either side, so the wall point 4 px from the edge (3 + 1 px) and the
+  // box point (6 + 1 px) cross it; the wall point 10 px away does not.
+  EXPECT_EQ(kept(Eigen::Vector3d(0.4, 0.0, 0.0)), (std::vector<int>{0, 0, 1}));
+  // Up and down by as much, along the edge: nothing crosses it.
+  EXPECT_EQ(kept(Eigen::Vector3d(0.0, 0.4, 0.0)), (std::vector<int>{1, 1, 1}));
+  // A smear of a pixel or less is within the 4-neighbours already checked.
+  EXPECT_EQ(kept(Eigen::Vector3d(0.05, 0.0, 0.0)), (std::vector<int>{1, 1, 1}));
+}
+
 // The engine as the odometry runs it, with and without the direct terms, on rendered pairs.
 TEST(DirectTerms, MakeTheDefaultEngineFinerThanItsKernel) {
   for (const bool texture : {true, false}) {

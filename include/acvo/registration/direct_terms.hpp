@@ -32,8 +32,9 @@ struct DirectImages {
   cv::Mat depth;  // CV_32FC1 metres, 0 or NaN = none (the cloud's own)
   Camera camera;
   // Per point of the cloud: its grey level smoothed by a Gaussian of kSmoothing pixels, and
-  // whether its depth is one surface at its pixel's 4 neighbours (a grey value at a depth edge
-  // belongs to either side; a point there is never used).
+  // whether its depth is one surface at its pixel's 4 neighbours and along its motion blur
+  // (LabelledCloud::blur_motion): a grey value at a depth edge, or blurred over one, belongs to
+  // either side; such a point is never used.
   std::vector<float> point_intensity;
   std::vector<std::uint8_t> one_surface;
   // A reference's whole grey image, smoothed likewise (CV_32FC1; addReferenceImages): moving

@@ -272,9 +272,13 @@ std::shared_ptr<PreparedCloud> Odometry::buildCloud(const Frame& frame, Odometry
   const bool every_frame_a_reference = params_.odometry.reference == Reference::kPreviousFrame;
   const Frame at_colour_time = depthAtColourTime(frame, r);
   arena_->arena.execute([&] {
-    current =
-        engine_->prepare(buildLabelledCloud(at_colour_time, params_.selection, &r.cloud_stats),
-                         every_frame_a_reference);
+    LabelledCloud cloud = buildLabelledCloud(at_colour_time, params_.selection, &r.cloud_stats);
+    // The motion while the shutter was open, as the last frame-to-frame motion says.
+    const double exposure = params_.coarse_to_fine.exposure_time;
+    if (exposure > 0.0 && velocity_interval_ > 0.0) {
+      cloud.blur_motion = expSE3(logSE3(velocity_) * (exposure / velocity_interval_));
+    }
+    current = engine_->prepare(std::move(cloud), every_frame_a_reference);
   });
   r.ms_cloud = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
   r.moving_points = current->size();

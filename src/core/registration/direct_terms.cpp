@@ -39,6 +39,35 @@ bool smoothAround(const cv::Mat& depth, const cv::Point& p, float z) {
          sameSurface(depth.at<float>(p.y + 1, p.x), z);
 }
 
+// Whether the depth along point j's blur (its image motion over cloud.blur_motion, centred on
+// its pixel, a pixel more at each end) is the point's own surface: a colour edge blurred over a
+// depth edge gives the points near it the other surface's colour.
+constexpr double kMaxBlurCheck = 64.0;  // pixels; a point blurred over more is not used
+bool oneSurfaceAlongBlur(const LabelledCloud& cloud, std::size_t j) {
+  if (cloud.blur_motion.matrix() == Eigen::Matrix4d::Identity()) return true;
+  const Camera& cam = cloud.camera;
+  const Eigen::Vector3d x = cloud.points[j].cast<double>();
+  const Eigen::Vector3d y = cloud.blur_motion * x;
+  if (!(y.z() > 0.0)) return false;
+  const Eigen::Vector2d m(cam.fx * (y.x() / y.z() - x.x() / x.z()),
+                          cam.fy * (y.y() / y.z() - x.y() / x.z()));
+  const double length = m.norm();
+  if (!(length > 1.0)) return true;  // within the 4-neighbours smoothAround checked
+  if (!(length < kMaxBlurCheck)) return false;
+  const float z = cloud.points[j].z();
+  const cv::Point& p = cloud.pixels[j];
+  const Eigen::Vector2d dir = m / length;
+  const double reach = 0.5 * length + 1.0;
+  for (double t = -reach; t <= reach; t += 1.0) {
+    const int u = int(std::lround(p.x + t * dir.x())), v = int(std::lround(p.y + t * dir.y()));
+    if (u < 0 || v < 0 || u >= cloud.depth.cols || v >= cloud.depth.rows ||
+        !sameSurface(cloud.depth.at<float>(v, u), z)) {
+      return false;
+    }
+  }
+  return true;
+}
+
 // Whether the surface goes on straight from step a to step b (within kFold).
 constexpr double kFold = 0.2;  // sine of the largest turn, about 12 deg
 bool straight(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
@@ -155,7 +184,8 @@ DirectImages directImages(const LabelledCloud& cloud) {
   };
   for (std::size_t j = 0; j < cloud.size(); ++j) {
     const cv::Point& p = cloud.pixels[j];
-    out.one_surface[j] = smoothAround(cloud.depth, p, cloud.points[j].z());
+    out.one_surface[j] = smoothAround(cloud.depth, p, cloud.points[j].z()) &&
+                         oneSurfaceAlongBlur(cloud, j);
     const bool inside =
         p.x >= half && p.y >= half && p.x + half < g.cols && p.y + half < g.rows;
     float sum = 0.0f;
