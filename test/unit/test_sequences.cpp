@@ -115,12 +115,12 @@ TEST_P(Sequences, RpeOverOneSecondOnASyntheticSequence) {
 
 INSTANTIATE_TEST_SUITE_P(StructureTexture, Sequences,
                          // Measured, default engine (keyframes, max_depth 10, the last
-                         // level's direct terms): 0.00053/0.0108, 0.00195/0.0426,
+                         // level's direct terms): 0.00055/0.0115, 0.00200/0.0441,
                          // 0.00019/0.0054 (the kernel alone: 0.0024/0.062, 0.0047/0.134,
                          // 0.0013/0.042; frame to frame it was 0.0078/0.208,
                          // 0.0129/0.300, 0.0032/0.174); paper.yaml (the authors' settings):
                          // 0.0151/0.423, 0.0438/0.987, 0.0052/0.184; cvo.yaml 0.0344/0.862,
-                         // 0.0805/1.799, 0.0058/0.232. The default's bounds are 1.3x.
+                         // 0.0805/1.799, 0.0058/0.232. The default's bounds are 1.2-1.3x.
                          ::testing::Values(Condition{true, true, 0.00069, 0.0140, 0.018, 0.51},
                                            Condition{true, false, 0.0025, 0.0554, 0.053, 1.19},
                                            Condition{false, true, 0.00025, 0.0070, 0.0063, 0.22}),
@@ -183,7 +183,7 @@ TEST(Sequences, EveryOtherFrameMissingStillTracks) {
               run.rpe.trans.rmse, run.rpe.rot_deg.rmse, run.rpe.pairs, run.lost);
   EXPECT_TRUE(allFinite(run.estimate));
   EXPECT_EQ(run.lost, 0);
-  // Measured 0.00031 m/s, 0.0064 deg/s (the kernel alone 0.0024, 0.064; frame to frame
+  // Measured 0.00031 m/s, 0.0065 deg/s (the kernel alone 0.0024, 0.064; frame to frame
   // 0.0063, 0.143); bounds 1.3x.
   EXPECT_LT(run.rpe.trans.rmse, 0.00040);
   EXPECT_LT(run.rpe.rot_deg.rmse, 0.0083);
@@ -278,7 +278,7 @@ TEST(Sequences, RpeOnRealKinectFrames) {
     std::printf("  kitchen7s_dev %-14s RPE %.4f m/s %.3f deg/s, %d lost\n", kRunNames[p],
                 runs[p].rpe.trans.rmse, runs[p].rpe.rot_deg.rmse, runs[p].lost);
   }
-  // Measured 0.0293 m/s, 3.364 deg/s (default; the kernel alone 0.0315, 3.118; frame to frame
+  // Measured 0.0299 m/s, 3.348 deg/s (default; the kernel alone 0.0315, 3.118; frame to frame
   // 0.0336, 3.52); paper.yaml 0.0631 m/s, 4.49 deg/s; cvo.yaml 0.0893, 5.47. Bounds 1.1x.
   // 7-Scenes colour and depth come from two unregistered cameras: the labels sit beside their
   // points, which costs accuracy here.
@@ -330,11 +330,11 @@ TEST(Sequences, RealHandHeldMotionIsTrackedWithoutLossOrDrift) {
       "  tum_fr3_teddy200 default RPE %.4f m/s %.3f deg/s, ATE %.4f m (frame to frame "
       "%.4f m), %d lost\n",
       rpe.trans.rmse, rpe.rot_deg.rmse, ate, ate_previous, lost[0]);
-  // Measured 0.0060 m/s, 0.509 deg/s; ATE 0.0057 m against 0.0144 m frame to frame (the kernel
+  // Measured 0.0059 m/s, 0.473 deg/s; ATE 0.0062 m against 0.0154 m frame to frame (the kernel
   // alone: 0.0086, 0.579, ATE 0.0105; max_depth 4: 0.0159, 1.066, ATE 0.0185). Bounds 1.3x.
   EXPECT_EQ(lost[0], 0);
-  EXPECT_LT(rpe.trans.rmse, 0.0078);
-  EXPECT_LT(rpe.rot_deg.rmse, 0.662);
+  EXPECT_LT(rpe.trans.rmse, 0.0077);
+  EXPECT_LT(rpe.rot_deg.rmse, 0.615);
   // Keyframes against drift: at most 0.7 of the frame-to-frame ATE (the target).
   EXPECT_LT(ate, 0.7 * ate_previous);
 }
@@ -403,9 +403,9 @@ TEST(Sequences, FastRotationIsNeverLost) {
   for (int i = 1; i < seq.size(); ++i) {
     EXPECT_NE(run.tracking[std::size_t(i)], Tracking::kLost) << "frame " << i;
   }
-  // Measured 0.00062 m/s, 0.0134 deg/s (the kernel alone 0.0023, 0.064; frame to frame 0.0042,
-  // 0.111); bounds 1.3x.
-  EXPECT_LT(run.rpe.trans.rmse, 0.00081);
+  // Measured 0.00055 m/s, 0.0138 deg/s (the kernel alone 0.0023, 0.064; frame to frame 0.0042,
+  // 0.111); bounds 1.3x, 1.26x.
+  EXPECT_LT(run.rpe.trans.rmse, 0.00072);
   EXPECT_LT(run.rpe.rot_deg.rmse, 0.0174);
 }
 
@@ -436,11 +436,11 @@ TEST(Sequences, UnsynchronisedColourAndDepthAreBroughtToOneInstant) {
                 runs[p].rpe.rot_deg.rmse, runs[p].lost);
     EXPECT_EQ(runs[p].lost, 0);
   }
-  // Measured 0.00059 m/s, 0.0092 deg/s moved and 0.00290, 0.0599 as it came (150 frames of the
+  // Measured 0.00055 m/s, 0.0079 deg/s moved and 0.00259, 0.0487 as it came (150 frames of the
   // same motion without the delay: 0.0003, 0.008); bounds 1.3x, and moving it at least 3x
   // better.
-  EXPECT_LT(runs[0].rpe.trans.rmse, 1.3 * 0.00059);
-  EXPECT_LT(runs[0].rpe.rot_deg.rmse, 1.3 * 0.0092);
+  EXPECT_LT(runs[0].rpe.trans.rmse, 1.3 * 0.00055);
+  EXPECT_LT(runs[0].rpe.rot_deg.rmse, 1.3 * 0.0079);
   EXPECT_GT(runs[1].rpe.trans.rmse, 3.0 * runs[0].rpe.trans.rmse);
   EXPECT_GT(runs[1].rpe.rot_deg.rmse, 3.0 * runs[0].rpe.rot_deg.rmse);
 }
@@ -465,11 +465,11 @@ TEST(Sequences, AutoExposureIsMeasuredNotMistakenForMotion) {
                 runs[p].rpe.rot_deg.rmse, runs[p].lost);
     EXPECT_EQ(runs[p].lost, 0);
   }
-  // Measured 0.00040 m/s, 0.0072 deg/s at the gain and 0.00114, 0.0259 as they are (150 frames
+  // Measured 0.00039 m/s, 0.0074 deg/s at the gain and 0.00117, 0.0255 as they are (150 frames
   // of this room without the swing, scripts/results: 0.0004, 0.008); bounds 1.3x, and the gain
   // at least 2x better.
-  EXPECT_LT(runs[0].rpe.trans.rmse, 1.3 * 0.00040);
-  EXPECT_LT(runs[0].rpe.rot_deg.rmse, 1.3 * 0.0072);
+  EXPECT_LT(runs[0].rpe.trans.rmse, 1.3 * 0.00039);
+  EXPECT_LT(runs[0].rpe.rot_deg.rmse, 1.3 * 0.0074);
   EXPECT_GT(runs[1].rpe.trans.rmse, 2.0 * runs[0].rpe.trans.rmse);
   EXPECT_GT(runs[1].rpe.rot_deg.rmse, 2.0 * runs[0].rpe.rot_deg.rmse);
 }
@@ -524,9 +524,9 @@ TEST(Sequences, VignettingIsMeasuredNotMistakenForMotion) {
                 runs[p].rpe.rot_deg.rmse, runs[p].lost);
     EXPECT_EQ(runs[p].lost, 0);
   }
-  // Measured 0.00047 m/s, 0.0088 deg/s measured and 0.00098, 0.0186 not modelled; bounds
+  // Measured 0.00046 m/s, 0.0088 deg/s measured and 0.00096, 0.0182 not modelled; bounds
   // 1.3x, and the model at least 1.5x better.
-  EXPECT_LT(runs[0].rpe.trans.rmse, 1.3 * 0.00047);
+  EXPECT_LT(runs[0].rpe.trans.rmse, 1.3 * 0.00046);
   EXPECT_LT(runs[0].rpe.rot_deg.rmse, 1.3 * 0.0088);
   EXPECT_GT(runs[1].rpe.trans.rmse, 1.5 * runs[0].rpe.trans.rmse);
   EXPECT_GT(runs[1].rpe.rot_deg.rmse, 1.5 * runs[0].rpe.rot_deg.rmse);
