@@ -157,6 +157,9 @@ class Odometry {
   };
   struct Registration;
   // The steps of process(), in order.
+  // The camera's motion over `seconds`, as the last frame-to-frame motion says; none until two
+  // frames were tracked.
+  std::optional<Eigen::Isometry3d> motionOver(double seconds) const;
   // The frame with its depth moved to the colour's time when they differ (sync_depth).
   Frame depthAtColourTime(const Frame& frame, OdometryResult& r) const;
   // The cloud of the frame at its colour's time.

@@ -248,17 +248,24 @@ OdometryResult Odometry::process(const Frame& frame,
   return r;
 }
 
+std::optional<Eigen::Isometry3d> Odometry::motionOver(double seconds) const {
+  if (!(velocity_interval_ > 0.0)) return std::nullopt;
+  return expSE3(logSE3(velocity_) * (seconds / velocity_interval_));
+}
+
 Frame Odometry::depthAtColourTime(const Frame& frame, OdometryResult& r) const {
   const double delay = frame.depth_stamp != 0.0 ? frame.stamp - frame.depth_stamp : 0.0;
   r.depth_delay = delay;
   // The motion over the delay, as the last frame-to-frame motion says (the colour's stamps
   // measure both); unknown until two frames were tracked.
-  if (!params_.odometry.sync_depth || delay == 0.0 || !(velocity_interval_ > 0.0)) return frame;
-  const Eigen::Isometry3d moved = expSE3(logSE3(velocity_) * (delay / velocity_interval_));
-  if (largestPixelShift(moved, frame.camera, params_.selection.min_depth) < kSyncMinShift)
+  if (!params_.odometry.sync_depth || delay == 0.0) return frame;
+  const std::optional<Eigen::Isometry3d> moved = motionOver(delay);
+  if (!moved ||
+      largestPixelShift(*moved, frame.camera, params_.selection.min_depth) < kSyncMinShift) {
     return frame;
+  }
   Frame at_colour_time = frame;
-  at_colour_time.depth = depthSeenFrom(frame.depth, frame.camera, moved);
+  at_colour_time.depth = depthSeenFrom(frame.depth, frame.camera, *moved);
   r.depth_synced = true;
   return at_colour_time;
 }
@@ -273,10 +280,9 @@ std::shared_ptr<PreparedCloud> Odometry::buildCloud(const Frame& frame, Odometry
   const Frame at_colour_time = depthAtColourTime(frame, r);
   arena_->arena.execute([&] {
     LabelledCloud cloud = buildLabelledCloud(at_colour_time, params_.selection, &r.cloud_stats);
-    // The motion while the shutter was open, as the last frame-to-frame motion says.
-    const double exposure = params_.coarse_to_fine.exposure_time;
-    if (exposure > 0.0 && velocity_interval_ > 0.0) {
-      cloud.blur_motion = expSE3(logSE3(velocity_) * (exposure / velocity_interval_));
+    // The motion while the shutter was open.
+    if (const double exposure = params_.coarse_to_fine.exposure_time; exposure > 0.0) {
+      cloud.blur_motion = motionOver(exposure).value_or(Eigen::Isometry3d::Identity());
     }
     current = engine_->prepare(std::move(cloud), every_frame_a_reference);
   });
