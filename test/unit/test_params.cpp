@@ -315,6 +315,13 @@ TEST(Params, ValidateCatchesInconsistentValues) {
             std::string::npos);
   EXPECT_NE(message([](Params& p) { p.odometry.lost_speed = -1.0; }).find("odometry.lost_speed"),
             std::string::npos);
+  for (const double exposure : {-0.001, 1.5, std::numeric_limits<double>::quiet_NaN()}) {
+    EXPECT_NE(message([exposure](Params& p) { p.coarse_to_fine.exposure_time = exposure; })
+                  .find("coarse_to_fine.exposure_time"),
+              std::string::npos)
+        << exposure;
+  }
+  EXPECT_EQ(message([](Params& p) { p.coarse_to_fine.exposure_time = 0.0; }), "");
   // The YAML loader applies the same checks.
   const std::string msg = expectThrowMessage("coarse_to_fine:\n  sigma: -1\n");
   EXPECT_NE(msg.find("coarse_to_fine.sigma"), std::string::npos) << msg;
