@@ -1,4 +1,4 @@
-// acvo_tum: runs A-CVO odometry over a TUM-format dataset folder and writes the trajectory.
+// acvo_tum: runs acvo's odometry over a TUM-format dataset folder and writes the trajectory.
 #include <unistd.h>
 
 #include <algorithm>
@@ -22,14 +22,16 @@
 namespace {
 
 constexpr const char* kDescription =
-    R"(Runs A-CVO frame-to-frame odometry over a TUM RGB-D folder (rgb.txt, depth.txt,
-optional associations.txt, groundtruth.txt, camera.yaml) and writes the trajectory in
-TUM format (default DATASET_DIR/acvo_trajectory.txt). The first pose is the ground-truth
-pose of the first frame when groundtruth.txt exists, identity otherwise.
+    R"(Runs acvo's odometry over a TUM RGB-D folder (rgb.txt, depth.txt, optional
+associations.txt, groundtruth.txt, camera.yaml) and writes the trajectory in TUM format
+(default DATASET_DIR/acvo_trajectory.txt). Each frame is registered to the current keyframe
+(--set odometry.reference=previous_frame: to the frame before; --config config/paper.yaml:
+the paper's A-CVO). The first pose is the ground-truth pose of the first frame when
+groundtruth.txt exists, identity otherwise.
 )";
 
 constexpr const char* kFooter =
-    "--set overrides one parameter of the config, e.g. --set solver.ell_policy=fixed_schedule.\n"
+    "--set overrides one parameter of the config, e.g. --set coarse_to_fine.color_ell=0.2.\n"
     "Last line: frames=N median_ms=X p90_ms=Y failures=Z (cloud + registration per frame).\n"
     "Exit status: 0 success, 2 bad arguments or input.";
 
