@@ -14,6 +14,26 @@ namespace {
 // Streams of the per-row generators, so depth and colour noise of one frame are independent.
 constexpr std::uint64_t kDepthStream = 0x4445505448ull;
 constexpr std::uint64_t kColourStream = 0x434f4c4f5552ull;
+constexpr std::uint64_t kFieldStream = 0x4649454c44ull;
+
+// Unit-variance Gaussian noise correlated over `length` pixels: white noise (per-row
+// generators, as the rest) smoothed by a Gaussian of that standard deviation, divided by the
+// smoothing's own reduction of the standard deviation (the sum of the squared 1-D weights, for a
+// separable kernel; the reflected border keeps each sum of weights 1).
+cv::Mat correlatedField(cv::Size size, double length, std::uint64_t stream) {
+  cv::Mat field(size, CV_32FC1);
+  tbb::parallel_for(tbb::blocked_range<int>(0, size.height), [&](const tbb::blocked_range<int>& r) {
+    for (int v = r.begin(); v < r.end(); ++v) {
+      Rng rng(hashCombine(stream, v));
+      float* f = field.ptr<float>(v);
+      for (int u = 0; u < size.width; ++u) f[u] = static_cast<float>(rng.pixelNoise());
+    }
+  });
+  const int taps = 2 * int(std::ceil(3.0 * length)) + 1;
+  const cv::Mat kernel = cv::getGaussianKernel(taps, length, CV_64F);
+  cv::sepFilter2D(field, field, CV_32F, kernel, kernel, {-1, -1}, 0.0, cv::BORDER_REFLECT_101);
+  return field / kernel.dot(kernel);
+}
 
 }  // namespace
 
@@ -28,6 +48,10 @@ cv::Mat degradeDepth(const cv::Mat& exact, const KinectNoise& noise, double dept
   cv::erode(exact, lowest, box, {-1, -1}, 1, cv::BORDER_REPLICATE);
   cv::dilate(exact, highest, box, {-1, -1}, 1, cv::BORDER_REPLICATE);
   const std::uint64_t stream = hashCombine(seed, kDepthStream);
+  const cv::Mat field =
+      noise.correlation_px > 0.0
+          ? correlatedField(exact.size(), noise.correlation_px, hashCombine(seed, kFieldStream))
+          : cv::Mat();
   tbb::parallel_for(tbb::blocked_range<int>(0, exact.rows), [&](const tbb::blocked_range<int>& r) {
     for (int v = r.begin(); v < r.end(); ++v) {
       Rng rng(hashCombine(stream, v));
@@ -35,8 +59,10 @@ cv::Mat degradeDepth(const cv::Mat& exact, const KinectNoise& noise, double dept
       const float* lo = lowest.ptr<float>(v);
       const float* hi = highest.ptr<float>(v);
       float* o = out.ptr<float>(v);
+      const float* correlated = field.empty() ? nullptr : field.ptr<float>(v);
       for (int u = 0; u < exact.cols; ++u) {
-        const double gaussian = rng.pixelNoise();  // drawn for every pixel: fixed stream layout
+        double gaussian = rng.pixelNoise();  // drawn for every pixel: fixed stream layout
+        if (correlated) gaussian = correlated[u];
         const float z = in[u];
         if (!(z > 0.0f)) continue;
         const double jump = noise.edge_jump_base + noise.edge_jump_quadratic * z * z;

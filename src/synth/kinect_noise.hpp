@@ -6,7 +6,11 @@
 // light sensor: the depth step grows with z^2, about 3 mm at 1 m and 4.6 cm at 4 m); the
 // measuring range (0 outside it); finally the depth image's own unit (1/depth_scale m).
 // Colour: small noise per channel. Noise is near-Gaussian (Rng::pixelNoise: zero mean, the
-// stated standard deviation, tails cut at 3.5 sigma).
+// stated standard deviation, tails cut at 3.5 sigma). The depth noise is drawn per pixel, or,
+// with correlation_px > 0, as a smooth field: a structured-light sensor matches its pattern over
+// a window of pixels, so its errors come in blobs of neighbouring pixels that err together (the
+// field is white noise smoothed by a Gaussian of correlation_px pixels, then scaled back to unit
+// variance: neighbours d pixels apart correlate by exp(-d^2 / (4 correlation_px^2))).
 //
 // The random numbers of row v come from hashCombine(seed, v): results are identical for
 // any thread count.
@@ -31,6 +35,7 @@ struct KinectNoise {
   double edge_jump_base = 0.02;       // m
   double edge_jump_quadratic = 0.01;  // 1/m
   double colour_sigma = 1.5;          // 8-bit grey levels
+  double correlation_px = 0.0;        // px; the depth noise's correlation length (0: per pixel)
 
   double depthSigma(double z) const {
     const double e = z - sigma_offset;

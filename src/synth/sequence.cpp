@@ -36,6 +36,8 @@ const SequenceOptions& validated(const SequenceOptions& o) {
     throw std::invalid_argument("brightness_swing must be within [0, 0.9]");
   if (!(o.vignetting >= -3 && o.vignetting <= 0))
     throw std::invalid_argument("vignetting must be within [-3, 0]");
+  if (!(o.depth_noise_correlation >= 0 && o.depth_noise_correlation <= 50))
+    throw std::invalid_argument("depth_noise_correlation must be within [0, 50] pixels");
   return o;
 }
 
@@ -53,6 +55,9 @@ std::string describe(const SequenceOptions& o) {
   if (o.colour_delay != 0.0) s << ", colour taken " << o.colour_delay << " s after the depth";
   if (o.brightness_swing != 0.0) s << ", brightness swinging by " << o.brightness_swing;
   if (o.vignetting != 0.0) s << ", vignetting " << o.vignetting;
+  if (o.noise && o.depth_noise_correlation > 0.0) {
+    s << ", depth noise correlated over " << o.depth_noise_correlation << " px";
+  }
   return s.str();
 }
 
@@ -85,6 +90,7 @@ RenderOptions SequenceOptions::renderOptions() const {
   r.colour_focal_ratio = colour_focal_ratio;
   r.colour_baseline = colour_baseline;
   r.vignetting = vignetting;
+  r.kinect.correlation_px = depth_noise_correlation;
   return r;
 }
 

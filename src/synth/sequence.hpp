@@ -46,6 +46,9 @@ struct SequenceOptions {
   double brightness_swing = 0.0;
   // The colour camera's vignetting (RenderOptions::vignetting; 0 = none).
   double vignetting = 0.0;
+  // The depth noise's correlation length in pixels (KinectNoise::correlation_px; 0 = each
+  // pixel's own).
+  double depth_noise_correlation = 0.0;
   Camera camera;                // TUM default intrinsics, 640x480, depth scale 5000
   double first_stamp = 1000.0;  // seconds; frame i is at first_stamp + i / rate
 
@@ -63,7 +66,8 @@ class SynthSequence {
   // Throws std::invalid_argument for bad options (frames < 0, rate <= 0, speed < 0,
   // invalid camera, blur_samples < 1, exposure outside [0, 1], colour_focal_ratio outside
   // [0.5, 2], colour_baseline not within 1 m, colour_delay not under half a frame interval,
-  // brightness_swing outside [0, 0.9], vignetting outside [-3, 0]).
+  // brightness_swing outside [0, 0.9], vignetting outside [-3, 0], depth_noise_correlation
+  // outside [0, 50]).
   explicit SynthSequence(const SequenceOptions& options);
 
   int size() const { return options_.frames; }

@@ -105,6 +105,14 @@ int main(int argc, char** argv) {
       ->type_name("V")
       ->capture_default_str()
       ->transform(acvo::tools::numberIn(-3.0, 0.0, "within [-3, 0]"));
+  app.add_option("--depth-noise-correlation", o.depth_noise_correlation,
+                 "the depth noise in blobs of neighbouring pixels that err together, as a "
+                 "structured-light sensor's (its pattern is matched over a window): their "
+                 "correlation length in pixels (4: neighbours 10 px apart correlate by 0.2); 0: "
+                 "each pixel's own")
+      ->type_name("PX")
+      ->capture_default_str()
+      ->transform(acvo::tools::numberIn(0.0, 50.0, "within [0, 50] pixels"));
   const auto size = acvo::tools::numberIn(8, 8192, "within [8, 8192] pixels");
   app.add_option("--width", width, "image width; the 640x480 intrinsics scale with the size")
       ->type_name("W")

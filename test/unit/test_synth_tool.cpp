@@ -294,6 +294,30 @@ TEST(SynthTool, VignettingDarkensTheColourTowardsTheCorners) {
   EXPECT_LT(cv::norm(dark.at<cv::Vec3b>(corner)), cv::norm(plain.at<cv::Vec3b>(corner)) + 1e-9);
 }
 
+// Depth noise in blobs (--depth-noise-correlation PX) changes the depth images alone, and only
+// where there is noise.
+TEST(SynthTool, DepthNoiseCorrelationChangesTheDepthAlone) {
+  const fs::path a = test::tempDir("synth_tool_noise_per_pixel"),
+                 b = test::tempDir("synth_tool_noise_blobs"),
+                 c = test::tempDir("synth_tool_exact_blobs"),
+                 d = test::tempDir("synth_tool_exact");
+  const std::string common = " --frames 2 --width 96 --height 72 --seed 4";
+  ASSERT_EQ(runTool("'" + a.string() + "'" + common), 0);
+  ASSERT_EQ(runTool("'" + b.string() + "'" + common + " --depth-noise-correlation 3"), 0);
+  ASSERT_EQ(
+      runTool("'" + c.string() + "'" + common + " --noise off --depth-noise-correlation 3"), 0);
+  ASSERT_EQ(runTool("'" + d.string() + "'" + common + " --noise off"), 0);
+  EXPECT_NE(readBytes(b / "rgb.txt").find("depth noise correlated over 3 px"), std::string::npos);
+  EXPECT_EQ(readBytes(c / "rgb.txt").find("correlated"), std::string::npos);
+  for (const auto& row : readRows(a / "rgb.txt")) {
+    EXPECT_EQ(readBytes(a / row[1]), readBytes(b / row[1]));
+  }
+  for (const auto& row : readRows(a / "depth.txt")) {
+    EXPECT_NE(readBytes(a / row[1]), readBytes(b / row[1]));
+    EXPECT_EQ(readBytes(c / row[1]), readBytes(d / row[1]));
+  }
+}
+
 // Mean absolute difference of two 8-bit colour images.
 double meanDifference(const fs::path& a, const fs::path& b) {
   const cv::Mat x = cv::imread(a.string()), y = cv::imread(b.string());
@@ -362,6 +386,8 @@ TEST(SynthTool, HelpAndBadOptions) {
   EXPECT_EQ(runTool(out + " --colour-delay 0.02"), 2);  // over half a frame at 30 Hz
   EXPECT_EQ(runTool(out + " --brightness-swing 1"), 2);
   EXPECT_EQ(runTool(out + " --vignetting 0.5"), 2);
+  EXPECT_EQ(runTool(out + " --depth-noise-correlation -1"), 2);
+  EXPECT_EQ(runTool(out + " --depth-noise-correlation 60"), 2);
   EXPECT_EQ(runTool(out + " --colour red"), 2);  // unknown option
   EXPECT_FALSE(fs::exists(test::tempDir("synth_tool_bad") / "rgb.txt"));
   // A folder that cannot be created is a run-time failure, not a usage error.
