@@ -72,6 +72,12 @@ struct SolverResult {
   double ms_ell = 0.0;         // length-scale update (paper)
 };
 
+enum class AlignStages { kAll, kCoarse, kFinest };
+
+// One registration run as kCoarse then kFinest: the finest stage's result, with the iterations,
+// trace and times of both.
+SolverResult combinedStages(const SolverResult& coarse, SolverResult finest);
+
 // A frame's cloud with what an engine built for it once. Each engine makes its own kind
 // (a derived type) and only ever receives the kind it made.
 struct PreparedCloud {
@@ -91,9 +97,17 @@ class RegistrationEngine {
   // Builds what a cloud registered *to* needs, once (a keyframe when it becomes one); returns
   // the milliseconds it took (0 when already done).
   virtual double prepareReference(PreparedCloud& cloud) const = 0;
-  // Registers `moving` onto `fixed` (a reference) starting from `guess`.
+  // Registers `moving` onto `fixed` (a reference) starting from `guess`. `stages`: all of them,
+  // or the ones before the finest and the finest alone, for a caller that changes the moving
+  // cloud in between (Odometry moves the depth to the colour's time again by the motion the
+  // first found); an engine without stages (staged() false) runs whole for every value.
   virtual SolverResult align(const PreparedCloud& fixed, const PreparedCloud& moving,
-                             const Eigen::Isometry3d& guess) const = 0;
+                             const Eigen::Isometry3d& guess, AlignStages stages) const = 0;
+  SolverResult align(const PreparedCloud& fixed, const PreparedCloud& moving,
+                     const Eigen::Isometry3d& guess) const {
+    return align(fixed, moving, guess, AlignStages::kAll);
+  }
+  virtual bool staged() const = 0;
   // Covariance of a registered motion (T: moving -> fixed, in the fixed frame's axes); nullopt
   // when the result does not constrain every direction.
   virtual std::optional<Matrix6d> covariance(const SolverResult& s,

@@ -394,5 +394,42 @@ TEST(DirectTerms, MakeTheDefaultEngineFinerThanItsKernel) {
   }
 }
 
+// The engine in two calls, the stages before the finest and then the finest from where they
+// left off, registers as one call does (Odometry moves the depth again in between).
+TEST(DirectTerms, TheEngineInTwoStagesIsTheEngineInOne) {
+  const Pair p = renderedPair(true, true);
+  const CoarseToFineParams params;
+  const auto A = prepareCoarseToFine(p.a, params, true);
+  const auto B = prepareCoarseToFine(p.b, params, false);
+  const Eigen::Isometry3d guess = Eigen::Isometry3d::Identity();
+  const SolverResult whole = alignCoarseToFine(*A, *B, guess, params);
+  const SolverResult coarse = alignCoarseToFine(*A, *B, guess, params, AlignStages::kCoarse);
+  const SolverResult finest =
+      alignCoarseToFine(*A, *B, coarse.transform, params, AlignStages::kFinest);
+  const SolverResult both = combinedStages(coarse, finest);
+  std::printf("  coarse levels %.4f mm %.5f deg, all %.4f mm %.5f deg\n",
+              errorOf(coarse.transform).mm, errorOf(coarse.transform).deg,
+              errorOf(whole.transform).mm, errorOf(whole.transform).deg);
+  EXPECT_GT(coarse.iterations, 0);
+  EXPECT_GT(finest.iterations, 0);
+  // Measured: the coarse levels alone 1.63 mm / 0.059 deg, all of them 0.049 mm / 0.0017 deg.
+  EXPECT_LT(errorOf(coarse.transform).mm, 2.5);
+  EXPECT_GT(errorOf(coarse.transform).mm, 10.0 * errorOf(whole.transform).mm);
+  EXPECT_TRUE(both.transform.isApprox(whole.transform, 1e-12));
+  EXPECT_EQ(both.iterations, whole.iterations);
+  EXPECT_EQ(both.trace.size(), whole.trace.size());
+  EXPECT_EQ(both.nnz, whole.nnz);
+  EXPECT_EQ(both.matched_fraction, whole.matched_fraction);
+  EXPECT_EQ(both.status, whole.status);
+
+  // One level only: nothing before the finest, the guess comes back.
+  CoarseToFineParams one = params;
+  one.ell_init = one.ell_min;
+  const SolverResult none = alignCoarseToFine(*A, *B, trueMotion(), one, AlignStages::kCoarse);
+  EXPECT_EQ(none.iterations, 0);
+  EXPECT_EQ(none.status, SolverStatus::kConverged);
+  EXPECT_TRUE(none.transform.isApprox(trueMotion(), 1e-15));
+}
+
 }  // namespace
 }  // namespace acvo

@@ -86,16 +86,21 @@ std::shared_ptr<CoarseToFineCloud> prepareCoarseToFine(LabelledCloud cloud,
                                                       const CoarseToFineParams& p,
                                                       bool as_reference);
 double prepareCoarseToFineReference(CoarseToFineCloud& cloud, const CoarseToFineParams& p);
+// `stages`: kCoarse the levels before the finest (none when there is one level: the guess comes
+// back), kFinest the finest alone.
 SolverResult alignCoarseToFine(const CoarseToFineCloud& fixed, const CoarseToFineCloud& moving,
-                               const Eigen::Isometry3d& guess, const CoarseToFineParams& p);
+                               const Eigen::Isometry3d& guess, const CoarseToFineParams& p,
+                               AlignStages stages = AlignStages::kAll);
 
 class CoarseToFineEngine : public RegistrationEngine {
  public:
   explicit CoarseToFineEngine(const CoarseToFineParams& params) : params_(params) {}
   std::shared_ptr<PreparedCloud> prepare(LabelledCloud cloud, bool as_reference) const override;
   double prepareReference(PreparedCloud& cloud) const override;
+  using RegistrationEngine::align;
   SolverResult align(const PreparedCloud& fixed, const PreparedCloud& moving,
-                     const Eigen::Isometry3d& guess) const override;
+                     const Eigen::Isometry3d& guess, AlignStages stages) const override;
+  bool staged() const override { return true; }
   // covariance_scale (-H)^-1: the information weighs each point by its own kernel, whatever
   // the number of its pairs.
   std::optional<Matrix6d> covariance(const SolverResult& s,

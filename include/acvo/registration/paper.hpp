@@ -90,8 +90,10 @@ class PaperEngine : public RegistrationEngine {
   explicit PaperEngine(const PaperParams& params) : params_(params) {}
   std::shared_ptr<PreparedCloud> prepare(LabelledCloud cloud, bool as_reference) const override;
   double prepareReference(PreparedCloud& cloud) const override;
+  using RegistrationEngine::align;
   SolverResult align(const PreparedCloud& fixed, const PreparedCloud& moving,
-                     const Eigen::Isometry3d& guess) const override;
+                     const Eigen::Isometry3d& guess, AlignStages stages) const override;
+  bool staged() const override { return false; }
   // covariance_scale * (pairs per point) * (-H)^-1: neighbouring pairs of one point are far
   // from independent measurements, the information comes from the moving points.
   std::optional<Matrix6d> covariance(const SolverResult& s,

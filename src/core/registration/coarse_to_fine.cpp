@@ -154,7 +154,8 @@ double prepareCoarseToFineReference(CoarseToFineCloud& cloud, const CoarseToFine
 }
 
 SolverResult alignCoarseToFine(const CoarseToFineCloud& fixed, const CoarseToFineCloud& moving,
-                               const Eigen::Isometry3d& guess, const CoarseToFineParams& p) {
+                               const Eigen::Isometry3d& guess, const CoarseToFineParams& p,
+                               AlignStages stages) {
   const auto t_start = Clock::now();
   SolverResult result;
   result.transform = guess;
@@ -174,7 +175,13 @@ SolverResult alignCoarseToFine(const CoarseToFineCloud& fixed, const CoarseToFin
   std::unique_ptr<LevelKernel> kernel;
   LabelledCloud subset;
   const int levels = int(ells.size());
-  for (int level = 0; level < levels; ++level) {
+  const int first = stages == AlignStages::kFinest ? levels - 1 : 0;
+  const int end = stages == AlignStages::kCoarse ? levels - 1 : levels;
+  if (first >= end) {
+    result.ms_total = msSince(t_start);
+    return result;
+  }
+  for (int level = first; level < end; ++level) {
     const double ell = ells[std::size_t(level)];
     const bool last = level + 1 == levels;
     const int count = int(std::min<double>(moving.size(), p.level_points * ells.front() / ell));
@@ -226,9 +233,9 @@ double CoarseToFineEngine::prepareReference(PreparedCloud& cloud) const {
 }
 
 SolverResult CoarseToFineEngine::align(const PreparedCloud& fixed, const PreparedCloud& moving,
-                                       const Eigen::Isometry3d& guess) const {
+                                       const Eigen::Isometry3d& guess, AlignStages stages) const {
   return alignCoarseToFine(static_cast<const CoarseToFineCloud&>(fixed),
-                           static_cast<const CoarseToFineCloud&>(moving), guess, params_);
+                           static_cast<const CoarseToFineCloud&>(moving), guess, params_, stages);
 }
 
 std::optional<Matrix6d> CoarseToFineEngine::covariance(const SolverResult& s,

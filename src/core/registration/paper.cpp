@@ -243,7 +243,7 @@ double PaperEngine::prepareReference(PreparedCloud& cloud) const {
 }
 
 SolverResult PaperEngine::align(const PreparedCloud& fixed, const PreparedCloud& moving,
-                                const Eigen::Isometry3d& guess) const {
+                                const Eigen::Isometry3d& guess, AlignStages /*stages*/) const {
   const bool carry = params_.carry_ell && params_.ell_policy == EllPolicy::kFixedSchedule;
   SolverResult r = alignPaper(static_cast<const PaperCloud&>(fixed),
                               static_cast<const PaperCloud&>(moving), guess, params_,

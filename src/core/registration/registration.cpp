@@ -22,6 +22,17 @@ std::string toString(SolverStatus s) {
   return "unknown";
 }
 
+SolverResult combinedStages(const SolverResult& coarse, SolverResult finest) {
+  finest.iterations += coarse.iterations;
+  finest.list_builds += coarse.list_builds;
+  finest.trace.insert(finest.trace.begin(), coarse.trace.begin(), coarse.trace.end());
+  finest.ms_total += coarse.ms_total;
+  finest.ms_neighbours += coarse.ms_neighbours;
+  finest.ms_step += coarse.ms_step;
+  finest.ms_ell += coarse.ms_ell;
+  return finest;
+}
+
 std::optional<SolverStatus> inputProblem(const PreparedCloud& fixed, const PreparedCloud& moving,
                                          const Eigen::Isometry3d& guess, int min_points) {
   if (int(fixed.size()) < min_points || int(moving.size()) < min_points) {
