@@ -50,4 +50,11 @@ struct CloudStats {
 LabelledCloud buildLabelledCloud(const Frame& frame, const SelectionParams& params,
                                  CloudStats* stats = nullptr);
 
+// The cloud of the same pixels with their points from `depth_m` (CV_32FC1 metres, the same
+// camera's depth at the cloud's instant, measured again: Odometry moves the depth to the
+// colour's time by a better motion). Pixels whose depth there is missing or outside
+// [min_depth, max_depth] are dropped; labels, colours and the grey image stay the pixels' own.
+LabelledCloud withDepth(const LabelledCloud& cloud, const cv::Mat& depth_m,
+                        const SelectionParams& params);
+
 }  // namespace acvo

@@ -60,6 +60,9 @@ struct OdometryResult {
   // whether the depth was moved over it (OdometryParams::sync_depth, a velocity known).
   double depth_delay = 0.0;
   bool depth_synced = false;
+  // ... and moved (again) by the motion the registration's first stages found for this frame,
+  // which matches its colour better than the last frame's motion can.
+  bool depth_retimed = false;
   // building this frame's cloud (the depth moved to the colour's time, selection, labels,
   // self-kernel)
   double ms_cloud = 0.0;
@@ -98,6 +101,11 @@ Matrix6d frameMotionCovariance(const Eigen::Isometry3d& last, const Matrix6d& la
 // the last motion, measured over `measured` seconds: that motion scaled down in proportion when
 // it spanned clearly more time (< 3/4 of it: a registration across a blackout); never scaled up.
 Eigen::Isometry3d motionPrior(const Eigen::Isometry3d& last, double measured, double interval);
+
+// The frame with the depth its registration used: moved to the colour's time where the odometry
+// moved it (OdometryResult::depth_synced, depth_retimed), as it came otherwise. What looks at
+// colour and depth together (ColourDepthCheck) sees them of one instant, as the odometry did.
+Frame depthAsRegistered(const Frame& frame, const OdometryResult& r);
 
 // Whether a frame registered to the keyframe becomes the next keyframe (keyframe reference):
 // hard to track, matched below keyframe_matched_fraction, or moved beyond keyframe_translation
@@ -167,12 +175,24 @@ class Odometry {
   void start(OdometryResult& r, const std::shared_ptr<PreparedCloud>& current);
   // To the keyframe from the prior, then (lost) to the last tracked frame; fills r's solver
   // figures and judgement.
-  Registration registerFrame(OdometryResult& r, const PreparedCloud& current,
+  Registration registerFrame(OdometryResult& r, const Frame& frame,
+                             const std::shared_ptr<PreparedCloud>& current,
                              const Eigen::Isometry3d& prior);
   // Builds the search grids a cloud registered to needs (prepareReference), timed into r.
   void asReference(OdometryResult& r, PreparedCloud& cloud);
-  Registration registerTo(const Tracked& reference, const PreparedCloud& current,
-                          const Eigen::Isometry3d& guess);
+  // One registration of the frame's cloud to `reference`. Where the depth is of another
+  // instant than the colour (retimes), in two stages with the depth moved again in between.
+  Registration registerTo(const Tracked& reference, const std::shared_ptr<PreparedCloud>& current,
+                          const Eigen::Isometry3d& guess, const Frame& frame, OdometryResult& r);
+  // Whether registrations of this frame move its depth again (sync_depth, a delay, a staged
+  // engine).
+  bool retimes(const OdometryResult& r) const;
+  // The frame's cloud with its depth moved to the colour's time by `frame_motion` (the motion
+  // from the last tracked frame over r.interval), when that moves a pixel by a tenth or more
+  // against what the cloud was built with; null otherwise.
+  std::shared_ptr<PreparedCloud> retimedCloud(const PreparedCloud& current, const Frame& frame,
+                                              const Eigen::Isometry3d& frame_motion,
+                                              OdometryResult& r) const;
   void tracked(OdometryResult& r, const Registration& reg,
                const std::shared_ptr<PreparedCloud>& current);
   void lost(OdometryResult& r, const Registration& reg,

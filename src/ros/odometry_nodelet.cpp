@@ -373,7 +373,7 @@ void OdometryNodelet::processFrame(const Image& rgb, const Image& depth, const I
   }
   acvo::OdometryResult r = odometry_->process(frame, tf.motion_guess);
   ++count_.frames;
-  checkRegistration(frame);
+  checkRegistration(acvo::depthAsRegistered(frame, r));
   if (!tf.base_from_camera && r.tracking != acvo::Tracking::kBadFrame) {
     r.message += std::string(r.message.empty() ? "" : "; ") + "not published: no transform from '" +
                  baseFrame() + "' to '" + camera_frame_ + "' yet";
@@ -381,12 +381,11 @@ void OdometryNodelet::processFrame(const Image& rgb, const Image& depth, const I
   last_.tracking = r.tracking;
   last_.message = r.message;
   last_.depth_delay = r.depth_delay;
-  last_.depth_synced = r.depth_synced;
-  if (r.depth_synced && !depth_sync_told_) {
+  last_.depth_synced = r.depth_synced || r.depth_retimed;
+  if (last_.depth_synced && !depth_sync_told_) {
     depth_sync_told_ = true;
     NODELET_INFO("colour and depth stamps differ (%.1f ms on this frame): each frame's depth is "
-                 "moved to its colour's time by the last frame-to-frame motion "
-                 "(odometry/sync_depth)",
+                 "moved to its colour's time by the camera's motion (odometry/sync_depth)",
                  1e3 * r.depth_delay);
   }
   InfoExtras extras;

@@ -130,7 +130,8 @@ int main(int argc, char** argv) {
         const acvo::Frame frame = data.loadFrame(std::size_t(k));
         r = odometry.process(frame);
         if (!colour_check.decided() && (k - first) % acvo::ColourDepthCheck::kFrameStep == 0 &&
-            colour_check.add(frame).state == acvo::ColourDepthCheck::State::kUnregistered) {
+            colour_check.add(acvo::depthAsRegistered(frame, r)).state ==
+                acvo::ColourDepthCheck::State::kUnregistered) {
           std::cerr << (progress ? "\n" : "") << "acvo_tum: warning: " << colour_check.describe()
                     << "\n";
         }
@@ -161,7 +162,8 @@ int main(int argc, char** argv) {
               << ',' << r.cloud_stats.ms_labels << ',' << r.ms_prepare << ',' << r.ms_cloud << ','
               << s.ms_neighbours << ',' << s.ms_step << ',' << s.ms_ell << ',' << r.ms_registration
               << ',' << ms << ',' << acvo::tools::residentKiB() << ',' << r.keyframe_index << ','
-              << int(r.new_keyframe) << ',' << 1e3 * r.depth_delay << ',' << int(r.depth_synced)
+              << int(r.new_keyframe) << ',' << 1e3 * r.depth_delay << ','
+              << (r.depth_retimed ? 2 : int(r.depth_synced))
               << ',' << s.brightness_gain << ',' << s.vignetting << '\n';
       }
       if (progress) {

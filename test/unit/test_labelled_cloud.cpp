@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <cmath>
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -233,6 +234,48 @@ TEST(LabelledCloud, CarriesStampSizeAndStats) {
   EXPECT_EQ(stats.selection.cell_size, direct.cell_size);
   EXPECT_GT(stats.ms_selection, 0.0);
   EXPECT_GT(stats.ms_labels, 0.0);
+}
+
+// The same pixels with another depth image: their points from it, the pixels it has no usable
+// depth for dropped, each label, colour and pixel still its own.
+TEST(LabelledCloud, WithDepthKeepsThePixelsAndTakesTheirPointsFromTheNewDepth) {
+  const Frame f = frameOf(primaries(), ColorOrder::kRgb, 2.f);
+  const SelectionParams params;
+  const LabelledCloud cloud = buildLabelledCloud(f, params);
+  ASSERT_GT(cloud.size(), 10u);
+
+  // The same depth: the same cloud.
+  const LabelledCloud same = withDepth(cloud, f.depth, params);
+  EXPECT_EQ(same.pixels, cloud.pixels);
+  EXPECT_EQ(same.points, cloud.points);
+  EXPECT_EQ(same.rgb, cloud.rgb);
+  ASSERT_EQ(same.labels.size(), cloud.labels.size());
+  for (std::size_t i = 0; i < cloud.size(); ++i) EXPECT_EQ(same.labels[i], cloud.labels[i]);
+  EXPECT_EQ(same.stamp, cloud.stamp);
+
+  // Right of column 160 the surface is at 3 m; the first selected pixel loses its depth, the
+  // second's is beyond max_depth, the third's NaN.
+  cv::Mat depth = f.depth.clone();
+  depth.colRange(160, depth.cols).setTo(3.f);
+  depth.at<float>(cloud.pixels[0]) = 0.f;
+  depth.at<float>(cloud.pixels[1]) = float(params.max_depth) + 0.5f;
+  depth.at<float>(cloud.pixels[2]) = std::nanf("");
+  const LabelledCloud moved = withDepth(cloud, depth, params);
+  ASSERT_EQ(moved.size(), cloud.size() - 3);
+  EXPECT_EQ(moved.labels.size(), moved.size());
+  EXPECT_EQ(moved.rgb.size(), moved.size());
+  EXPECT_EQ(moved.pixels.size(), moved.size());
+  EXPECT_EQ(moved.depth.data, depth.data);
+  for (std::size_t i = 0; i < moved.size(); ++i) {
+    const std::size_t j = i + 3;  // the first three are gone
+    ASSERT_EQ(moved.pixels[i], cloud.pixels[j]);
+    EXPECT_EQ(moved.rgb[i], cloud.rgb[j]);
+    EXPECT_EQ(moved.labels[i], cloud.labels[j]);
+    const cv::Point p = moved.pixels[i];
+    const double z = p.x < 160 ? 2.0 : 3.0;
+    EXPECT_TRUE(moved.points[i].isApprox(f.camera.backProject(p.x, p.y, z).cast<float>()));
+  }
+  EXPECT_THROW(withDepth(cloud, cv::Mat(10, 10, CV_32FC1), params), std::invalid_argument);
 }
 
 TEST(LabelledCloud, RejectsUnusableFrames) {

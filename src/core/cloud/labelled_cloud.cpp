@@ -84,4 +84,36 @@ LabelledCloud buildLabelledCloud(const Frame& frame, const SelectionParams& para
   return cloud;
 }
 
+LabelledCloud withDepth(const LabelledCloud& cloud, const cv::Mat& depth_m,
+                        const SelectionParams& params) {
+  if (depth_m.type() != CV_32FC1 || depth_m.cols != cloud.width || depth_m.rows != cloud.height) {
+    throw std::invalid_argument("withDepth: expects CV_32FC1 metres of the cloud's image size");
+  }
+  LabelledCloud out;
+  out.stamp = cloud.stamp;
+  out.width = cloud.width;
+  out.height = cloud.height;
+  out.gray = cloud.gray;
+  out.depth = depth_m;
+  out.camera = cloud.camera;
+  out.blur_motion = cloud.blur_motion;
+  out.points.reserve(cloud.size());
+  out.labels.reserve(cloud.size());
+  out.pixels.reserve(cloud.size());
+  out.rgb.reserve(cloud.size());
+  const auto min_d = static_cast<float>(params.min_depth);
+  const auto max_d = static_cast<float>(params.max_depth);
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const cv::Point& p = cloud.pixels[i];
+    const float z = depth_m.at<float>(p.y, p.x);
+    // The selection's own test (NaN fails it too).
+    if (!(z > 0.f && z >= min_d && z <= max_d)) continue;
+    out.points.emplace_back(cloud.camera.backProject(p.x, p.y, z).cast<float>());
+    out.labels.push_back(cloud.labels[i]);
+    out.pixels.push_back(p);
+    out.rgb.push_back(cloud.rgb[i]);
+  }
+  return out;
+}
+
 }  // namespace acvo

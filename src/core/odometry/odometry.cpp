@@ -24,6 +24,9 @@ struct Odometry::Arena {
 
 // One registration of the current frame to a reference, judged, with its covariance.
 struct Odometry::Registration {
+  // The cloud registered: the frame's own, or its cloud with the depth moved to the colour's
+  // time again by the motion this registration found (retimedCloud).
+  std::shared_ptr<PreparedCloud> moving;
   SolverResult solver;
   Judgement judgement;
   Matrix6d covariance = lostCovariance();  // of the motion, when tracked
@@ -84,6 +87,13 @@ double rotationDeg(const Eigen::Isometry3d& T) {
   return logSE3(T).head<3>().norm() * 180.0 / M_PI;
 }
 }  // namespace
+
+Frame depthAsRegistered(const Frame& frame, const OdometryResult& r) {
+  if (!(r.depth_synced || r.depth_retimed) || !r.cloud || r.cloud->depth.empty()) return frame;
+  Frame out = frame;
+  out.depth = r.cloud->depth;
+  return out;
+}
 
 Judgement judgeTracking(const SolverResult& s, const Eigen::Isometry3d& frame_motion,
                         const OdometryParams& params) {
@@ -186,25 +196,48 @@ void Odometry::asReference(OdometryResult& r, PreparedCloud& cloud) {
   r.ms_cloud += ms;
 }
 
-Odometry::Registration Odometry::registerTo(const Tracked& reference, const PreparedCloud& current,
-                                            const Eigen::Isometry3d& guess) {
+Odometry::Registration Odometry::registerTo(const Tracked& reference,
+                                            const std::shared_ptr<PreparedCloud>& current,
+                                            const Eigen::Isometry3d& guess, const Frame& frame,
+                                            OdometryResult& r) {
   Registration reg;
+  reg.moving = current;
   reg.fixed_points = reference.cloud->size();
-  arena_->arena.execute([&] { reg.solver = engine_->align(*reference.cloud, current, guess); });
   // The motion limits hold per frame: from the last tracked frame, not from an older keyframe.
   const bool from_last = &reference == &*last_ || last_->index == reference.index;
-  reg.judgement = judgeTracking(
-      reg.solver,
-      from_last ? reg.solver.transform : last_->to_keyframe.inverse() * reg.solver.transform,
-      params_.odometry);
+  auto frameMotion = [&](const Eigen::Isometry3d& to_reference) {
+    return from_last ? to_reference : last_->to_keyframe.inverse() * to_reference;
+  };
+  arena_->arena.execute([&] {
+    if (!retimes(r)) {
+      reg.solver = engine_->align(*reference.cloud, *current, guess);
+      return;
+    }
+    // The depth was moved to the colour's time by the last frame's motion (or not at all); the
+    // stages before the finest find this frame's own, and the finest registers the depth moved
+    // by that.
+    const SolverResult coarse =
+        engine_->align(*reference.cloud, *current, guess, AlignStages::kCoarse);
+    if (coarse.status == SolverStatus::kTooFewPoints || coarse.status == SolverStatus::kNotFinite) {
+      reg.solver = coarse;
+      return;
+    }
+    if (auto again = retimedCloud(*current, frame, frameMotion(coarse.transform), r)) {
+      reg.moving = std::move(again);
+    }
+    reg.solver = combinedStages(
+        coarse, engine_->align(*reference.cloud, *reg.moving, coarse.transform,
+                               AlignStages::kFinest));
+  });
+  reg.judgement = judgeTracking(reg.solver, frameMotion(reg.solver.transform), params_.odometry);
   const SolverResult& s = reg.solver;
   if (s.status == SolverStatus::kTooFewPoints || s.status == SolverStatus::kNotFinite) {
     reg.judgement.message += " (" + std::to_string(reg.fixed_points) + " and " +
-                             std::to_string(current.size()) + " points)";
+                             std::to_string(reg.moving->size()) + " points)";
   }
   if (reg.judgement.tracking == Tracking::kLost) return reg;
 
-  const std::optional<Matrix6d> cov = engine_->covariance(s, current.size());
+  const std::optional<Matrix6d> cov = engine_->covariance(s, reg.moving->size());
   if (!cov) {
     reg.covariance = lostCovariance();
     if (reg.judgement.tracking == Tracking::kOk) {
@@ -239,11 +272,19 @@ OdometryResult Odometry::process(const Frame& frame,
       : params_.odometry.initial_guess == InitialGuess::kConstantVelocity
           ? motionPrior(velocity_, velocity_interval_, r.interval)
           : Eigen::Isometry3d::Identity();
-  Registration reg = registerFrame(r, *current, prior);
+  Registration reg = registerFrame(r, frame, current, prior);
+  // A lost frame's motion moves no depth: its cloud is kept as built (it may become the
+  // reference).
+  if (reg.judgement.tracking == Tracking::kLost) reg.moving = current;
+  r.depth_retimed = reg.moving != current;
+  if (r.depth_retimed) {
+    r.cloud = std::shared_ptr<const LabelledCloud>(reg.moving, &reg.moving->cloud);
+    r.moving_points = reg.moving->size();
+  }
   if (reg.judgement.tracking == Tracking::kLost) {
-    lost(r, reg, current, frame.stamp);
+    lost(r, reg, reg.moving, frame.stamp);
   } else {
-    tracked(r, reg, current);
+    tracked(r, reg, reg.moving);
   }
   return r;
 }
@@ -268,6 +309,35 @@ Frame Odometry::depthAtColourTime(const Frame& frame, OdometryResult& r) const {
   at_colour_time.depth = depthSeenFrom(frame.depth, frame.camera, *moved);
   r.depth_synced = true;
   return at_colour_time;
+}
+
+bool Odometry::retimes(const OdometryResult& r) const {
+  return params_.odometry.sync_depth && r.depth_delay != 0.0 && r.interval > 0.0 &&
+         engine_->staged();
+}
+
+std::shared_ptr<PreparedCloud> Odometry::retimedCloud(const PreparedCloud& current,
+                                                      const Frame& frame,
+                                                      const Eigen::Isometry3d& frame_motion,
+                                                      OdometryResult& r) const {
+  const auto t0 = std::chrono::steady_clock::now();
+  // What the cloud was built with: the last frame-to-frame motion over the delay, or nothing.
+  const Eigen::Isometry3d before =
+      r.depth_synced ? motionOver(r.depth_delay).value_or(Eigen::Isometry3d::Identity())
+                     : Eigen::Isometry3d::Identity();
+  const Eigen::Isometry3d moved = expSE3(logSE3(frame_motion) * (r.depth_delay / r.interval));
+  if (largestPixelShift(before.inverse() * moved, frame.camera, params_.selection.min_depth) <
+      kSyncMinShift) {
+    return nullptr;
+  }
+  // The pixels stay those selected: the colour image has not changed, only where the depth
+  // puts their points.
+  LabelledCloud cloud =
+      withDepth(current.cloud, depthSeenFrom(frame.depth, frame.camera, moved), params_.selection);
+  auto out = engine_->prepare(std::move(cloud), current.reference);
+  r.ms_cloud += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                    .count();
+  return out;
 }
 
 std::shared_ptr<PreparedCloud> Odometry::buildCloud(const Frame& frame, OdometryResult& r) {
@@ -304,19 +374,20 @@ void Odometry::start(OdometryResult& r, const std::shared_ptr<PreparedCloud>& cu
   r.new_keyframe = true;
 }
 
-Odometry::Registration Odometry::registerFrame(OdometryResult& r, const PreparedCloud& current,
+Odometry::Registration Odometry::registerFrame(OdometryResult& r, const Frame& frame,
+                                               const std::shared_ptr<PreparedCloud>& current,
                                                const Eigen::Isometry3d& prior) {
   const bool last_is_keyframe = last_->index == keyframe_->index;
   // From the keyframe: where the last tracked frame was, then the prior's motion.
-  Registration reg =
-      registerTo(*keyframe_, current, last_is_keyframe ? prior : last_->to_keyframe * prior);
+  Registration reg = registerTo(*keyframe_, current,
+                                last_is_keyframe ? prior : last_->to_keyframe * prior, frame, r);
   r.ms_registration = reg.solver.ms_total;
 
   // Failed against the keyframe: the last tracked frame, closer in time, may still overlap.
   if (reg.judgement.tracking == Tracking::kLost && !last_is_keyframe &&
-      int(current.size()) >= engine_->minPoints()) {
+      int(current->size()) >= engine_->minPoints()) {
     asReference(r, *last_->cloud);
-    Registration to_last = registerTo(*last_, current, prior);
+    Registration to_last = registerTo(*last_, current, prior, frame, r);
     r.ms_registration += to_last.solver.ms_total;
     if (to_last.judgement.tracking != Tracking::kLost) {
       keyframe_ = last_;
