@@ -15,7 +15,9 @@
 // 0.01 of 1), an unregistered one away from it (7-Scenes' kitchen: 0.91, 1.6x; rendered at
 // 0.897: 0.88-0.90, 1.3-1.6x; at 1.1: 1.10, 1.27x). A baseline between the two cameras is not
 // searched: at 2.5 cm it moves the colour by 6 px at 2 m, the focal length up to 30 px, and a
-// two-parameter search mistook texture for silhouettes on rendered rooms.
+// two-parameter search mistook texture for silhouettes on rendered rooms. Colour and depth of two
+// instants (free-running streams) misalign by the motion between them: callers give the depth as
+// the odometry registered it (depthAsRegistered, odometry.hpp).
 #pragma once
 
 #include <array>
