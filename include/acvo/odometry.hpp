@@ -102,9 +102,10 @@ Matrix6d frameMotionCovariance(const Eigen::Isometry3d& last, const Matrix6d& la
 // it spanned clearly more time (< 3/4 of it: a registration across a blackout); never scaled up.
 Eigen::Isometry3d motionPrior(const Eigen::Isometry3d& last, double measured, double interval);
 
-// The frame with the depth its registration used: moved to the colour's time where the odometry
-// moved it (OdometryResult::depth_synced, depth_retimed), as it came otherwise. What looks at
-// colour and depth together (ColourDepthCheck) sees them of one instant, as the odometry did.
+// The frame with the depth its registration used (its cloud's): moved to the colour's time where
+// the odometry moved it (OdometryResult::depth_synced, depth_retimed), as it came otherwise; the
+// frame as given when it has no cloud (a bad frame). What looks at colour and depth together
+// (ColourDepthCheck) sees them of one instant, as the odometry did.
 Frame depthAsRegistered(const Frame& frame, const OdometryResult& r);
 
 // Whether a frame registered to the keyframe becomes the next keyframe (keyframe reference):

@@ -17,6 +17,16 @@ struct Selection {
   bool canny_used = false;
 };
 
+// The depths a selected pixel may have: valid (0 and NaN are not) and within [min_depth,
+// max_depth].
+struct SelectableDepth {
+  explicit SelectableDepth(const SelectionParams& p)
+      : min(static_cast<float>(p.min_depth)), max(static_cast<float>(p.max_depth)) {}
+  // NaN fails every comparison.
+  bool operator()(float d) const { return d > 0.f && d >= min && d <= max; }
+  float min, max;
+};
+
 // gray: CV_8UC1; depth: CV_32FC1 metres, 0 = invalid (same size). Deterministic for a given
 // input. Pixels within 4 px of the border and pixels whose depth is invalid or outside
 // [min_depth, max_depth] are never returned.

@@ -101,13 +101,11 @@ LabelledCloud withDepth(const LabelledCloud& cloud, const cv::Mat& depth_m,
   out.labels.reserve(cloud.size());
   out.pixels.reserve(cloud.size());
   out.rgb.reserve(cloud.size());
-  const auto min_d = static_cast<float>(params.min_depth);
-  const auto max_d = static_cast<float>(params.max_depth);
+  const SelectableDepth selectable(params);
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     const cv::Point& p = cloud.pixels[i];
     const float z = depth_m.at<float>(p.y, p.x);
-    // The selection's own test (NaN fails it too).
-    if (!(z > 0.f && z >= min_d && z <= max_d)) continue;
+    if (!selectable(z)) continue;
     out.points.emplace_back(cloud.camera.backProject(p.x, p.y, z).cast<float>());
     out.labels.push_back(cloud.labels[i]);
     out.pixels.push_back(p);

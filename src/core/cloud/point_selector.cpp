@@ -356,13 +356,10 @@ Selection selectPixels(const cv::Mat& gray, const cv::Mat& depth, const Selectio
 
   std::sort(picks.begin(), picks.end());  // pixel indices: row-major order
   out.pixels.reserve(picks.size());
-  const auto min_d = static_cast<float>(params.min_depth);
-  const auto max_d = static_cast<float>(params.max_depth);
+  const SelectableDepth selectable(params);
   for (int idx : picks) {
     const int u = idx % gray.cols, v = idx / gray.cols;
-    const float d = depth.at<float>(v, u);
-    // NaN fails every comparison, so it is dropped here too.
-    if (d > 0.f && d >= min_d && d <= max_d) out.pixels.emplace_back(u, v);
+    if (selectable(depth.at<float>(v, u))) out.pixels.emplace_back(u, v);
   }
   return out;
 }

@@ -83,13 +83,20 @@ double largestPixelShift(const Eigen::Isometry3d& moved, const Camera& c, double
 // synchronised to tens of microseconds).
 constexpr double kSyncMinShift = 0.1;
 
+// The camera's motion over `seconds` at the constant velocity of `motion`, measured over
+// `measured` seconds.
+Eigen::Isometry3d atConstantVelocity(const Eigen::Isometry3d& motion, double measured,
+                                     double seconds) {
+  return expSE3(logSE3(motion) * (seconds / measured));
+}
+
 double rotationDeg(const Eigen::Isometry3d& T) {
   return logSE3(T).head<3>().norm() * 180.0 / M_PI;
 }
 }  // namespace
 
 Frame depthAsRegistered(const Frame& frame, const OdometryResult& r) {
-  if (!(r.depth_synced || r.depth_retimed) || !r.cloud || r.cloud->depth.empty()) return frame;
+  if (!r.cloud || r.cloud->depth.empty()) return frame;
   Frame out = frame;
   out.depth = r.cloud->depth;
   return out;
@@ -134,7 +141,7 @@ Eigen::Isometry3d motionPrior(const Eigen::Isometry3d& last, double measured, do
   // frame's motion is a small guess, that motion times the frames the pause spans could be far
   // off. Stamp jitter (below 4/3 of the interval), or no usable stamps: the last motion as is.
   if (!(measured > 0.0) || !(interval > 0.0) || 0.75 * measured <= interval) return last;
-  return expSE3(logSE3(last) * (interval / measured));
+  return atConstantVelocity(last, measured, interval);
 }
 
 bool takesKeyframe(const Judgement& judgement, const SolverResult& s,
@@ -291,7 +298,7 @@ OdometryResult Odometry::process(const Frame& frame,
 
 std::optional<Eigen::Isometry3d> Odometry::motionOver(double seconds) const {
   if (!(velocity_interval_ > 0.0)) return std::nullopt;
-  return expSE3(logSE3(velocity_) * (seconds / velocity_interval_));
+  return atConstantVelocity(velocity_, velocity_interval_, seconds);
 }
 
 Frame Odometry::depthAtColourTime(const Frame& frame, OdometryResult& r) const {
@@ -325,7 +332,7 @@ std::shared_ptr<PreparedCloud> Odometry::retimedCloud(const PreparedCloud& curre
   const Eigen::Isometry3d before =
       r.depth_synced ? motionOver(r.depth_delay).value_or(Eigen::Isometry3d::Identity())
                      : Eigen::Isometry3d::Identity();
-  const Eigen::Isometry3d moved = expSE3(logSE3(frame_motion) * (r.depth_delay / r.interval));
+  const Eigen::Isometry3d moved = atConstantVelocity(frame_motion, r.interval, r.depth_delay);
   if (largestPixelShift(before.inverse() * moved, frame.camera, params_.selection.min_depth) <
       kSyncMinShift) {
     return nullptr;
