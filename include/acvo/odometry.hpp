@@ -16,6 +16,7 @@
 #include "acvo/params.hpp"
 #include "acvo/registration.hpp"
 #include "acvo/se3.hpp"
+#include "acvo/velocity_filter.hpp"
 
 namespace acvo {
 
@@ -188,12 +189,11 @@ class Odometry {
   // Whether registrations of this frame move its depth again (sync_depth, a delay, a staged
   // engine).
   bool retimes(const OdometryResult& r) const;
-  // The frame's cloud with its depth moved to the colour's time by `frame_motion` (the motion
-  // from the last tracked frame over r.interval), when that moves a pixel by a tenth or more
-  // against what the cloud was built with; null otherwise.
+  // The frame's cloud with its depth moved to the colour's time at `velocity` (a twist per
+  // second), when that moves a pixel by a tenth or more against what the cloud was built with;
+  // null otherwise.
   std::shared_ptr<PreparedCloud> retimedCloud(const PreparedCloud& current, const Frame& frame,
-                                              const Eigen::Isometry3d& frame_motion,
-                                              OdometryResult& r) const;
+                                              const Vector6d& velocity, OdometryResult& r) const;
   void tracked(OdometryResult& r, const Registration& reg,
                const std::shared_ptr<PreparedCloud>& current);
   void lost(OdometryResult& r, const Registration& reg,
@@ -205,6 +205,8 @@ class Odometry {
   Matrix6d pose_covariance_;
   Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();  // last frame-to-frame motion
   double velocity_interval_ = 0.0;  // s between the two frames of velocity_ (0: unknown)
+  // The velocity over a colour/depth delay: velocity_ against the frame's own (retimedCloud).
+  VelocityFilter velocity_filter_;
   std::optional<Tracked> keyframe_;
   std::optional<Tracked> last_;  // the last tracked frame (the keyframe itself, or after it)
   int lost_in_a_row_ = 0;

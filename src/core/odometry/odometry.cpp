@@ -25,8 +25,12 @@ struct Odometry::Arena {
 // One registration of the current frame to a reference, judged, with its covariance.
 struct Odometry::Registration {
   // The cloud registered: the frame's own, or its cloud with the depth moved to the colour's
-  // time again by the motion this registration found (retimedCloud).
+  // time again at the velocity this registration found, weighed against the last frame's
+  // (retimedCloud, VelocityFilter).
   std::shared_ptr<PreparedCloud> moving;
+  // This frame's velocity (twist per second) as the coarse levels found it, where the
+  // registration ran in two stages.
+  std::optional<Vector6d> coarse_velocity;
   SolverResult solver;
   Judgement judgement;
   Matrix6d covariance = lostCovariance();  // of the motion, when tracked
@@ -182,6 +186,7 @@ void Odometry::reset(const Eigen::Isometry3d& pose, const Matrix6d& covariance) 
   pose_covariance_ = covariance;
   velocity_ = Eigen::Isometry3d::Identity();
   velocity_interval_ = 0.0;
+  velocity_filter_.reset();
   keyframe_.reset();
   last_.reset();
   lost_in_a_row_ = 0;
@@ -229,9 +234,14 @@ Odometry::Registration Odometry::registerTo(const Tracked& reference,
       reg.solver = coarse;
       return;
     }
-    if (auto again = retimedCloud(*current, frame, frameMotion(coarse.transform), r)) {
-      reg.moving = std::move(again);
-    }
+    // The velocity over the delay: this frame's own as the coarse levels found it, weighed
+    // against the last frame's by what each has missed so far (VelocityFilter).
+    reg.coarse_velocity = logSE3(frameMotion(coarse.transform)) / r.interval;
+    const Vector6d velocity =
+        velocity_interval_ > 0.0
+            ? velocity_filter_.blend(logSE3(velocity_) / velocity_interval_, *reg.coarse_velocity)
+            : *reg.coarse_velocity;
+    if (auto again = retimedCloud(*current, frame, velocity, r)) reg.moving = std::move(again);
     reg.solver = combinedStages(
         coarse, engine_->align(*reference.cloud, *reg.moving, coarse.transform,
                                AlignStages::kFinest));
@@ -325,14 +335,14 @@ bool Odometry::retimes(const OdometryResult& r) const {
 
 std::shared_ptr<PreparedCloud> Odometry::retimedCloud(const PreparedCloud& current,
                                                       const Frame& frame,
-                                                      const Eigen::Isometry3d& frame_motion,
+                                                      const Vector6d& velocity,
                                                       OdometryResult& r) const {
   const auto t0 = std::chrono::steady_clock::now();
   // What the cloud was built with: the last frame-to-frame motion over the delay, or nothing.
   const Eigen::Isometry3d before =
       r.depth_synced ? motionOver(r.depth_delay).value_or(Eigen::Isometry3d::Identity())
                      : Eigen::Isometry3d::Identity();
-  const Eigen::Isometry3d moved = atConstantVelocity(frame_motion, r.interval, r.depth_delay);
+  const Eigen::Isometry3d moved = expSE3(velocity * r.depth_delay);
   if (largestPixelShift(before.inverse() * moved, frame.camera, params_.selection.min_depth) <
       kSyncMinShift) {
     return nullptr;
@@ -431,6 +441,13 @@ void Odometry::tracked(OdometryResult& r, const Registration& reg,
   pose_covariance_ = keyframe.covariance + rotateCovariance(reg.covariance, keyframe.pose.linear());
   r.pose = pose_;
   r.pose_covariance = pose_covariance_;
+  if (r.interval > 0.0) {
+    const Vector6d velocity = logSE3(r.motion) / r.interval;
+    if (velocity_interval_ > 0.0) {
+      velocity_filter_.addChange(velocity - logSE3(velocity_) / velocity_interval_);
+    }
+    if (reg.coarse_velocity) velocity_filter_.addCorrection(velocity - *reg.coarse_velocity);
+  }
   velocity_ = r.motion;
   velocity_interval_ = r.interval;
   lost_in_a_row_ = 0;
