@@ -154,9 +154,10 @@ struct OdometryParams {
   double lost_speed = 1.0;           // m/s
   double lost_angular_speed = 90.0;  // deg/s
   // Colour and depth taken at different times (Frame::depth_stamp): the depth is moved to the
-  // colour's time by the last frame-to-frame motion (constant velocity), then again by the
-  // frame's own motion as the registration's first stages find it, so that each point's colour
-  // and position are of one instant. Off: the two are paired as they come.
+  // colour's time by the last frame-to-frame motion (constant velocity), then again at a
+  // velocity weighed between that and the frame's own as the registration's first stages find
+  // it (VelocityFilter), so that each point's colour and position are of one instant. Off: the
+  // two are paired as they come.
   bool sync_depth = true;
 };
 

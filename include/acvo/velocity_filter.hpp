@@ -22,8 +22,7 @@ class VelocityFilter {
   Vector6d blend(const Vector6d& predicted, const Vector6d& measured) const;
   // The weight of the measurement: the Kalman gain change (change + correction)^-1 of the two
   // errors' running second moments, as full 6x6 matrices (a coarse registration's rotation
-  // and translation errors are correlated); the identity (the measurement alone) until each
-  // had six samples.
+  // and translation errors are correlated). Half of each where nothing was seen yet.
   Matrix6d gain() const;
 
   // The change of velocity from one tracked frame to the next (the prediction's error).

@@ -14,15 +14,14 @@ void VelocityFilter::add(const Vector6d& sample, Matrix6d& mean_square, int& cou
 }
 
 Matrix6d VelocityFilter::gain() const {
-  // Six samples at the least: fewer cannot span the six directions of a twist.
-  constexpr int kMinSamples = 6;
-  if (changes_ < kMinSamples || corrections_ < kMinSamples) return Matrix6d::Identity();
-  // A ridge far below either error keeps the solve defined where the samples happened to
-  // span fewer directions (a camera that never moved along one).
-  const Matrix6d sum = change_ + correction_ +
-                       (1e-9 * (change_ + correction_).trace() + 1e-30) * Matrix6d::Identity();
+  // Both moments start from the same negligible amount in every direction: where the samples
+  // say nothing yet (no sample, or a camera that never moved along a direction) the two
+  // estimates weigh alike, and the solve stays defined.
+  const double prior = 1e-9 * (change_ + correction_).trace() + 1e-30;
+  const Matrix6d change = change_ + prior * Matrix6d::Identity();
+  const Matrix6d sum = change + correction_ + prior * Matrix6d::Identity();
   // change * sum^-1, both symmetric.
-  return sum.ldlt().solve(change_).transpose();
+  return sum.ldlt().solve(change).transpose();
 }
 
 Vector6d VelocityFilter::blend(const Vector6d& predicted, const Vector6d& measured) const {
