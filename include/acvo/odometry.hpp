@@ -3,6 +3,7 @@
 // the pose and its covariance, judges tracking, takes keyframes.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -64,6 +65,10 @@ struct OdometryResult {
   // ... and moved (again) by the motion the registration's first stages found for this frame,
   // which matches its colour better than the last frame's motion can.
   bool depth_retimed = false;
+  // Where the registration ran in two stages for a delay: the weight VelocityFilter gave the
+  // frame's own velocity against the last frame's, rotation and translation (the mean of the
+  // gain's diagonal over each: near 0 the last frame's, near 1 its own); NaN otherwise.
+  Eigen::Vector2d own_velocity_weight = Eigen::Vector2d::Constant(std::nan(""));
   // building this frame's cloud (the depth moved to the colour's time, selection, labels,
   // self-kernel)
   double ms_cloud = 0.0;

@@ -237,6 +237,9 @@ Odometry::Registration Odometry::registerTo(const Tracked& reference,
     // The velocity over the delay: this frame's own as the coarse levels found it, weighed
     // against the last frame's by what each has missed so far (VelocityFilter).
     reg.coarse_velocity = logSE3(frameMotion(coarse.transform)) / r.interval;
+    const Matrix6d gain =
+        velocity_interval_ > 0.0 ? velocity_filter_.gain() : Matrix6d::Identity();
+    r.own_velocity_weight = {gain.diagonal().head<3>().mean(), gain.diagonal().tail<3>().mean()};
     const Vector6d velocity =
         velocity_interval_ > 0.0
             ? velocity_filter_.blend(logSE3(velocity_) / velocity_interval_, *reg.coarse_velocity)
