@@ -67,7 +67,8 @@ struct OdometryResult {
   bool depth_retimed = false;
   // Where the registration ran in two stages for a delay: the weight VelocityFilter gave the
   // frame's own velocity against the last frame's, rotation and translation (the mean of the
-  // gain's diagonal over each: near 0 the last frame's, near 1 its own); NaN otherwise.
+  // gain's diagonal over each: near 0 the last frame's, near 1 its own; a little outside where
+  // one part's correction comes from the other's); NaN otherwise.
   Eigen::Vector2d own_velocity_weight = Eigen::Vector2d::Constant(std::nan(""));
   // building this frame's cloud (the depth moved to the colour's time, selection, labels,
   // self-kernel)

@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
+#include <cstdio>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -155,6 +157,8 @@ class OdometryNodelet : public nodelet::Nodelet {
     double ms_latency = 0.0;
     double depth_delay = 0.0;   // s from the depth's stamp to the colour's
     bool depth_synced = false;  // the depth was moved to the colour's time
+    // The velocity filter's weight of the frame's own velocity (rotation, translation; NaN: none).
+    Eigen::Vector2d own_velocity_weight = Eigen::Vector2d::Constant(std::nan(""));
     ros::WallTime wall;  // last synchronised frame, good or bad
   };
 
@@ -382,6 +386,7 @@ void OdometryNodelet::processFrame(const Image& rgb, const Image& depth, const I
   last_.message = r.message;
   last_.depth_delay = r.depth_delay;
   last_.depth_synced = r.depth_synced || r.depth_retimed;
+  last_.own_velocity_weight = r.own_velocity_weight;
   if (last_.depth_synced && !depth_sync_told_) {
     depth_sync_told_ = true;
     NODELET_INFO("colour and depth stamps differ (%.1f ms on this frame): each frame's depth is "
@@ -766,8 +771,17 @@ void OdometryNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat
   stat.add("last ms total", last_.ms_total);
   stat.add("last ms latency", last_.ms_latency);
   stat.add("colour/depth registration", acvo::toString(colour_check_.verdict().state));
-  stat.addf("colour stamp - depth stamp (ms)", "%.2f%s", 1e3 * last_.depth_delay,
-            last_.depth_synced ? ", depth moved to the colour's time" : "");
+  std::string moved;
+  if (last_.depth_synced) {
+    moved = ", depth moved to the colour's time";
+    if (last_.own_velocity_weight.allFinite()) {
+      char weights[96];
+      std::snprintf(weights, sizeof weights, " (own velocity weighed %.2f rot, %.2f trans)",
+                    last_.own_velocity_weight[0], last_.own_velocity_weight[1]);
+      moved += weights;
+    }
+  }
+  stat.addf("colour stamp - depth stamp (ms)", "%.2f%s", 1e3 * last_.depth_delay, moved.c_str());
   stat.add("parameter problems",
            parameter_problems_.empty() ? std::string("none") : parameter_problems_);
   stat.add("messages received (rgb, depth, info)", std::to_string(count_.rgb.load()) + ", " +
