@@ -176,6 +176,8 @@ class Odometry {
   // The camera's motion over `seconds`, as the last frame-to-frame motion says; none until two
   // frames were tracked.
   std::optional<Eigen::Isometry3d> motionOver(double seconds) const;
+  // The last frame-to-frame velocity, a twist per second; none until two frames were tracked.
+  std::optional<Vector6d> lastVelocity() const;
   // The frame with its depth moved to the colour's time when they differ (sync_depth).
   Frame depthAtColourTime(const Frame& frame, OdometryResult& r) const;
   // The cloud of the frame at its colour's time.

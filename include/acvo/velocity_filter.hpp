@@ -18,8 +18,11 @@ class VelocityFilter {
   explicit VelocityFilter(double memory = 10.0) : memory_(memory) {}
 
   // Velocities are twists per second (logSE3 of a motion over its interval). Returns
-  // predicted + gain() * (measured - predicted).
-  Vector6d blend(const Vector6d& predicted, const Vector6d& measured) const;
+  // predicted + gain * (measured - predicted), `gain` as gain() gives it.
+  static Vector6d blend(const Matrix6d& gain, const Vector6d& predicted,
+                        const Vector6d& measured) {
+    return predicted + gain * (measured - predicted);
+  }
   // The weight of the measurement: the Kalman gain change (change + correction)^-1 of the two
   // errors' running second moments, as full 6x6 matrices (a coarse registration's rotation
   // and translation errors are correlated). Half of each where nothing was seen yet.

@@ -165,7 +165,8 @@ int main(int argc, char** argv) {
               << ',' << ms << ',' << acvo::tools::residentKiB() << ',' << r.keyframe_index << ','
               << int(r.new_keyframe) << ',' << 1e3 * r.depth_delay << ','
               << (r.depth_retimed ? 2 : int(r.depth_synced)) << ',' << r.own_velocity_weight[0]
-              << ',' << r.own_velocity_weight[1] << ',' << s.brightness_gain << ',' << s.vignetting << '\n';
+              << ',' << r.own_velocity_weight[1] << ',' << s.brightness_gain << ','
+              << s.vignetting << '\n';
       }
       if (progress) {
         std::fprintf(stderr, "\racvo_tum: frame %ld/%ld  %3d it  %6.1f ms  %s    ", k - first + 1,

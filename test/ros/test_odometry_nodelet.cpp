@@ -402,6 +402,20 @@ class Client {
     }
     return std::nullopt;
   }
+  // The value of `key` once `done` holds for it, or the last one seen after `timeout` s
+  // (diagnostics come once a second).
+  template <typename Done>
+  std::optional<std::string> diagnosticValueOnce(const std::string& key, Done&& done,
+                                                 double timeout = 5.0) {
+    std::optional<std::string> v;
+    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(timeout);
+    do {
+      v = diagnosticValue(key);
+      if (v && done(*v)) break;
+      ros::WallDuration(0.1).sleep();
+    } while (ros::WallTime::now() < deadline);
+    return v;
+  }
 
   std::optional<geometry_msgs::TransformStamped> lookup(const ros::Time& stamp) {
     try {
@@ -1439,16 +1453,9 @@ TEST(OdometryNodelet, DepthNotRegisteredToTheColourIsNamed) {
   const ros::WallTime since = ros::WallTime::now();
   ASSERT_TRUE(client->reset());
   client->run(range(0, 31));
-  // Diagnostics come once a second: the value once it is `want`, or the last one after 5 s.
   auto judged = [](const std::string& want) {
-    std::optional<std::string> v;
-    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(5.0);
-    do {
-      v = client->diagnosticValue("colour/depth registration");
-      if (v == want) break;
-      ros::WallDuration(0.1).sleep();
-    } while (ros::WallTime::now() < deadline);
-    return v;
+    return client->diagnosticValueOnce("colour/depth registration",
+                                       [&](const std::string& v) { return v == want; });
   };
   EXPECT_EQ(judged("registered"), "registered");
   EXPECT_FALSE(client->waitLog("does not look registered", since, 0.5));
@@ -1484,17 +1491,10 @@ bool setSyncDepth(bool on) {
 // and, with odometry/sync_depth on, that the depth was moved to the colour's time and how the
 // velocity filter weighed the frame's own velocity against the last frame's.
 TEST(OdometryNodelet, DepthOfAnotherStampIsShownMovedInTheDiagnostics) {
-  // The value once it contains `want`, or the last one after 5 s (diagnostics come once a
-  // second).
   auto shown = [](const std::string& want) {
-    std::optional<std::string> v;
-    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(5.0);
-    do {
-      v = client->diagnosticValue("colour stamp - depth stamp (ms)");
-      if (v && v->find(want) != std::string::npos) break;
-      ros::WallDuration(0.1).sleep();
-    } while (ros::WallTime::now() < deadline);
-    return v.value_or("(none)");
+    auto contains = [&](const std::string& v) { return v.find(want) != std::string::npos; };
+    return client->diagnosticValueOnce("colour stamp - depth stamp (ms)", contains)
+        .value_or("(none)");
   };
   ASSERT_TRUE(client->reset());
   client->run(range(0, 5));

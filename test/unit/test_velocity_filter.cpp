@@ -15,7 +15,8 @@ namespace {
 TEST(VelocityFilter, WeighsAlikeWhatNothingWasSeenOf) {
   VelocityFilter f;
   const Vector6d predicted = Vector6d::Zero(), measured = Vector6d::Constant(1.0);
-  EXPECT_TRUE(f.blend(predicted, measured).isApprox(Vector6d::Constant(0.5), 1e-12));
+  EXPECT_TRUE(VelocityFilter::blend(f.gain(), predicted, measured)
+                  .isApprox(Vector6d::Constant(0.5), 1e-12));
   // The prediction wrong by 1e-3 along rotation about x, the measurement by 1 there: along x
   // the prediction; in the directions no sample has seen, half of each.
   Vector6d along_x = Vector6d::Zero();
@@ -25,7 +26,7 @@ TEST(VelocityFilter, WeighsAlikeWhatNothingWasSeenOf) {
   // A non-finite sample (a frame whose motion was not finite) is not one.
   f.addChange(Vector6d::Constant(std::numeric_limits<double>::quiet_NaN()));
   ASSERT_TRUE(f.gain().allFinite());
-  const Vector6d blended = f.blend(predicted, measured);
+  const Vector6d blended = VelocityFilter::blend(f.gain(), predicted, measured);
   EXPECT_NEAR(blended[0], 1e-6 / (1e-6 + 1.0), 1e-9);
   for (int i = 1; i < 6; ++i) EXPECT_NEAR(blended[i], 0.5, 1e-9) << i;
   f.reset();
@@ -57,7 +58,7 @@ Errors simulate(double change, double error, bool coupled, unsigned seed) {
     const Vector6d predicted = truth;
     truth += step;
     const Vector6d measured = truth + noise;
-    const Vector6d blended = f.blend(predicted, measured);
+    const Vector6d blended = VelocityFilter::blend(f.gain(), predicted, measured);
     if (k >= 100) {
       se_p += (predicted - truth).squaredNorm();
       se_m += (measured - truth).squaredNorm();

@@ -236,14 +236,13 @@ Odometry::Registration Odometry::registerTo(const Tracked& reference,
     }
     // The velocity over the delay: this frame's own as the coarse levels found it, weighed
     // against the last frame's by what each has missed so far (VelocityFilter).
+    // Until a last velocity is known, the frame's own.
     reg.coarse_velocity = logSE3(frameMotion(coarse.transform)) / r.interval;
-    const Matrix6d gain =
-        velocity_interval_ > 0.0 ? velocity_filter_.gain() : Matrix6d::Identity();
+    const std::optional<Vector6d> last = lastVelocity();
+    const Matrix6d gain = last ? velocity_filter_.gain() : Matrix6d::Identity();
     r.own_velocity_weight = {gain.diagonal().head<3>().mean(), gain.diagonal().tail<3>().mean()};
     const Vector6d velocity =
-        velocity_interval_ > 0.0
-            ? velocity_filter_.blend(logSE3(velocity_) / velocity_interval_, *reg.coarse_velocity)
-            : *reg.coarse_velocity;
+        last ? VelocityFilter::blend(gain, *last, *reg.coarse_velocity) : *reg.coarse_velocity;
     if (auto again = retimedCloud(*current, frame, velocity, r)) reg.moving = std::move(again);
     reg.solver = combinedStages(
         coarse, engine_->align(*reference.cloud, *reg.moving, coarse.transform,
@@ -307,6 +306,11 @@ OdometryResult Odometry::process(const Frame& frame,
     tracked(r, reg, reg.moving);
   }
   return r;
+}
+
+std::optional<Vector6d> Odometry::lastVelocity() const {
+  if (!(velocity_interval_ > 0.0)) return std::nullopt;
+  return logSE3(velocity_) / velocity_interval_;
 }
 
 std::optional<Eigen::Isometry3d> Odometry::motionOver(double seconds) const {
@@ -446,9 +450,7 @@ void Odometry::tracked(OdometryResult& r, const Registration& reg,
   r.pose_covariance = pose_covariance_;
   if (r.interval > 0.0) {
     const Vector6d velocity = logSE3(r.motion) / r.interval;
-    if (velocity_interval_ > 0.0) {
-      velocity_filter_.addChange(velocity - logSE3(velocity_) / velocity_interval_);
-    }
+    if (const auto last = lastVelocity()) velocity_filter_.addChange(velocity - *last);
     if (reg.coarse_velocity) velocity_filter_.addCorrection(velocity - *reg.coarse_velocity);
   }
   velocity_ = r.motion;

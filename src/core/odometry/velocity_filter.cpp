@@ -24,8 +24,4 @@ Matrix6d VelocityFilter::gain() const {
   return sum.ldlt().solve(change).transpose();
 }
 
-Vector6d VelocityFilter::blend(const Vector6d& predicted, const Vector6d& measured) const {
-  return predicted + gain() * (measured - predicted);
-}
-
 }  // namespace acvo
