@@ -33,6 +33,10 @@ struct LabelledCloud {
   // The camera's motion while its shutter was open, as predicted (identity: none known). A
   // moving camera blurs the colour along each point's image motion over it.
   Eigen::Isometry3d blur_motion = Eigen::Isometry3d::Identity();
+  // Whether the depth was taken at another instant than the colour (Frame::depth_stamp set and
+  // not the colour's stamp), moved to the colour's time (Odometry, sync_depth) or not: it then
+  // carries the motion over the delay, or the error of the motion it was moved by.
+  bool depth_of_another_instant = false;
 
   std::size_t size() const { return points.size(); }
   bool empty() const { return points.empty(); }

@@ -64,6 +64,12 @@ struct CoarseToFineParams {
   // better than a Kinect's). Off: the kernel alone, as before them.
   bool photometric = true;
   bool point_to_plane = true;
+  // ... and the plane distances of the moving depth on a grid of pixels, each point a window's
+  // mean (dense_point_to_plane; direct_terms.hpp, denseGrid): ICP's evidence, used only where
+  // averaging pixels makes depth more precise (noise drawn per pixel, a simulator's) or where the
+  // depth is exact, and only on depth taken at the colour's instant (Frame::depth_stamp:
+  // a delay moves the depth by an estimated motion, whose error it would follow).
+  bool dense_point_to_plane = true;
   // The photometric term measures each frame's brightness against the reference's (the median
   // ratio of their grey values at the points it compares) and compares grey values at that
   // gain: a camera's auto exposure changes the brightness from frame to frame. Off: the grey
@@ -209,6 +215,7 @@ void visitParams(Params_& p, Visitor&& visit) {
   visit("coarse_to_fine", "level_acceleration", c.level_acceleration);
   visit("coarse_to_fine", "photometric", c.photometric);
   visit("coarse_to_fine", "point_to_plane", c.point_to_plane);
+  visit("coarse_to_fine", "dense_point_to_plane", c.dense_point_to_plane);
   visit("coarse_to_fine", "photometric_gain", c.photometric_gain);
   visit("coarse_to_fine", "photometric_vignetting", c.photometric_vignetting);
   visit("coarse_to_fine", "exposure_time", c.exposure_time);

@@ -162,6 +162,7 @@ acvo::AcvoConfig toConfig(const acvo::Params& params, LostOdom lost_odom) {
   c.level_iterations = params.coarse_to_fine.level_iterations;
   c.photometric = params.coarse_to_fine.photometric;
   c.point_to_plane = params.coarse_to_fine.point_to_plane;
+  c.dense_point_to_plane = params.coarse_to_fine.dense_point_to_plane;
   c.photometric_gain = params.coarse_to_fine.photometric_gain;
   c.photometric_vignetting = params.coarse_to_fine.photometric_vignetting;
   c.exposure_time = params.coarse_to_fine.exposure_time;
@@ -189,6 +190,7 @@ acvo::Params fromConfig(const acvo::AcvoConfig& config, acvo::Params base) {
   base.coarse_to_fine.level_iterations = config.level_iterations;
   base.coarse_to_fine.photometric = config.photometric;
   base.coarse_to_fine.point_to_plane = config.point_to_plane;
+  base.coarse_to_fine.dense_point_to_plane = config.dense_point_to_plane;
   base.coarse_to_fine.photometric_gain = config.photometric_gain;
   base.coarse_to_fine.photometric_vignetting = config.photometric_vignetting;
   base.coarse_to_fine.exposure_time = config.exposure_time;

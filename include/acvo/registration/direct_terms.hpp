@@ -6,7 +6,10 @@
 //  - point to plane: the point against the plane of the reference's depth there
 //    (projective association, as KinectFusion's ICP), weighed by how much better the depth
 //    is than the depth noise the kernel assumes: full weight on exact depth (a simulator's),
-//    none on a Kinect's.
+//    none on a Kinect's;
+//  - dense point to plane: the same for the moving depth on a grid of pixels, each point and
+//    each plane from a window's mean, where averaging makes the depth precise: noise drawn
+//    per pixel (a simulator's) or none (denseGrid).
 // Each term learns the scale s of its residuals from them at every iteration (1.4826 times their
 // median absolute value, a photometric residual counted by its squared gradient), gives each the
 // variance s^2 (plus, for a grey value, its gradient squared times the 1/12 px^2 to which an
@@ -27,6 +30,33 @@
 
 namespace acvo {
 
+// The depth of a frame on a grid of pixels, for the dense point-to-plane term. Each point is the
+// mean of the (2 kGridWindow + 1)^2 window around a grid pixel, over the pixels of its surface
+// (at least half the window). Averaging n pixels divides independent noise by sqrt(n) and
+// does nothing to noise that neighbours share; a real structured-light sensor's comes in blobs
+// (docs/accuracy.md, tenth round), a simulator's is drawn per pixel. Both are told apart on the
+// frame itself, from the twist z00 - z01 - z10 + z11 (blind to any plane) of single pixels
+// (t) and of the four 3x3 quarter means of each window (T): independent noise gives
+// var(t) = 9 var(T), noise in blobs var(t) << 9 var(T).
+struct DepthGrid {
+  std::vector<Eigen::Vector3d> points;  // the window means, camera frame
+  // var(t) / (9 var(T)), in [0, 1]: near 1 for noise drawn per pixel, 0.05-0.12 on real Kinect
+  // frames and on rendered noise in 3-px blobs.
+  double independence = 0.0;
+  // sqrt(9 var(T) / 4) / z^2: the standard deviation of a pixel's noise that a window does not
+  // average away, in units of depth_noise (1/m).
+  double shared_noise = 0.0;
+  // The weight of the term: the independence where it is at least kMinIndependence, else how
+  // far the shared noise is under the modelled depth noise (1 - shared_noise / (kPlaneFade
+  // depth_noise), as the sparse term's fade): exact depth, full weight.
+  double weight = 0.0;
+  bool empty() const { return points.empty(); }
+};
+constexpr int kGridStride = 10;  // pixels between grid points (3072 on a 640x480 image)
+constexpr int kGridWindow = 3;   // a window's half size: 7x7 pixels
+constexpr int kNormalReach = 4;  // pixels between a plane's window means
+constexpr double kMinIndependence = 0.5;
+
 // A cloud's images as the terms read them.
 struct DirectImages {
   cv::Mat depth;  // CV_32FC1 metres, 0 or NaN = none (the cloud's own)
@@ -40,6 +70,11 @@ struct DirectImages {
   // A reference's whole grey image, smoothed likewise (CV_32FC1; addReferenceImages): moving
   // points are sampled in it.
   cv::Mat intensity;
+  // The depth on a grid of pixels (denseGrid; empty when the dense term is off for this depth)
+  // and, for a reference with a grid, the integral image of its points (x, y, z, 1) (CV_64FC4):
+  // the mean point of any window in four reads.
+  DepthGrid grid;
+  cv::Mat point_sums;
   bool empty() const { return depth.empty(); }
   bool isReference() const { return !depth.empty() && !intensity.empty(); }
 };
@@ -49,9 +84,15 @@ struct DirectImages {
 constexpr double kSmoothing = 0.7;
 
 // From the cloud's grey and depth images (empty when the cloud has none): what a moving cloud
-// needs.
-DirectImages directImages(const LabelledCloud& cloud);
-// What a reference needs more: its whole smoothed grey image (none when `images` is empty).
+// needs; with `dense` the depth grid too, unless the cloud's depth was taken at another instant
+// than its colour (LabelledCloud::depth_of_another_instant) or the grid's weight (for
+// depth_noise) is 0.
+DirectImages directImages(const LabelledCloud& cloud, bool dense = false, double depth_noise = 0.0);
+// The depth grid of a depth image (CV_32FC1 metres, 0 or NaN = none), with its weight for the
+// modelled depth_noise; no points when the weight is 0.
+DepthGrid denseGrid(const cv::Mat& depth, const Camera& camera, double depth_noise);
+// What a reference needs more: its whole smoothed grey image and, when it has a depth grid, its
+// points' integral image (none when `images` is empty).
 void addReferenceImages(DirectImages& images, const LabelledCloud& cloud);
 
 // Where a moving point lands in the reference: point j, its position y there and its pixel
@@ -148,5 +189,11 @@ Brightness brightnessOf(const std::vector<GreyPair>& pairs, bool gain, bool vign
 constexpr double kPlaneFade = 0.5;
 DirectSums pointToPlaneSums(const DirectImages& reference, const std::vector<Landing>& landed,
                             double depth_noise);
+// r_k = n^T (T g_k - x) / z_k^2 for the moving grid's points g_k (DepthGrid), x the mean point
+// of the reference's window where T g_k projects and n the normal from the means kNormalReach
+// pixels to each side, where the reference's surface does not fold there; weighed by the
+// moving grid's weight. Nothing when either has no grid.
+DirectSums densePlaneSums(const DirectImages& reference, const DirectImages& moving_images,
+                          const Eigen::Isometry3d& T);
 
 }  // namespace acvo

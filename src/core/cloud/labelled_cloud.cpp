@@ -46,6 +46,7 @@ LabelledCloud buildLabelledCloud(const Frame& frame, const SelectionParams& para
   const auto t1 = Clock::now();
   LabelledCloud cloud;
   cloud.stamp = frame.stamp;
+  cloud.depth_of_another_instant = frame.depth_stamp != 0.0 && frame.depth_stamp != frame.stamp;
   cloud.width = frame.color.cols;
   cloud.height = frame.color.rows;
   // The frame's images are the caller's: the cloud keeps its own copies.
@@ -91,6 +92,7 @@ LabelledCloud withDepth(const LabelledCloud& cloud, const cv::Mat& depth_m,
   }
   LabelledCloud out;
   out.stamp = cloud.stamp;
+  out.depth_of_another_instant = cloud.depth_of_another_instant;
   out.width = cloud.width;
   out.height = cloud.height;
   out.gray = cloud.gray;

@@ -66,6 +66,11 @@ double addDirectTerms(const LevelSums& s, double ell, const LevelDirect& direct,
     H += d.H;
     g += d.g;
   }
+  if (p.dense_point_to_plane) {
+    const DirectSums d = densePlaneSums(*direct.reference, *direct.moving, T);
+    H += d.H;
+    g += d.g;
+  }
   return to_units;
 }
 
@@ -108,7 +113,7 @@ bool iterateLevel(LevelKernel& kernel, const LevelDirect& direct, double ell, do
 }  // namespace
 
 bool directTerms(const CoarseToFineParams& p) {
-  return p.photometric || p.point_to_plane;
+  return p.photometric || p.point_to_plane || p.dense_point_to_plane;
 }
 
 std::vector<double> levelElls(const CoarseToFineParams& p) {
@@ -134,7 +139,9 @@ std::shared_ptr<CoarseToFineCloud> prepareCoarseToFine(LabelledCloud cloud,
   const auto t0 = Clock::now();
   auto out = std::make_shared<CoarseToFineCloud>();
   out->cloud = std::move(cloud);
-  if (directTerms(p)) out->images = directImages(out->cloud);
+  if (directTerms(p)) {
+    out->images = directImages(out->cloud, p.dense_point_to_plane, p.depth_noise);
+  }
   out->ms_prepare = msSince(t0);
   if (as_reference) prepareCoarseToFineReference(*out, p);
   return out;

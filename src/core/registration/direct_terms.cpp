@@ -162,7 +162,7 @@ double weightedMedian(std::vector<std::pair<double, double>>& pairs) {
   return lo != pairs.end() ? lo->first : std::max_element(pairs.begin(), pairs.end())->first;
 }
 
-DirectImages directImages(const LabelledCloud& cloud) {
+DirectImages directImages(const LabelledCloud& cloud, bool dense, double depth_noise) {
   DirectImages out;
   if (cloud.gray.empty() || cloud.depth.empty() || cloud.pixels.size() != cloud.size()) {
     return out;
@@ -201,13 +201,103 @@ DirectImages directImages(const LabelledCloud& cloud) {
     }
     out.point_intensity[j] = sum;
   }
+  if (dense && !cloud.depth_of_another_instant) {
+    out.grid = denseGrid(cloud.depth, cloud.camera, depth_noise);
+  }
   return out;
+}
+
+DepthGrid denseGrid(const cv::Mat& depth, const Camera& camera, double depth_noise) {
+  DepthGrid grid;
+  const cv::Mat& D = depth;
+  constexpr int w = kGridWindow, quarter = w * w;
+  auto inside = [&D](int u, int v) { return u >= w && v >= w && u + w < D.cols && v + w < D.rows; };
+  // The squared twists of the windows that are one surface whole, in units of z^2.
+  std::vector<double> t2, T2;
+  for (int v = kGridStride / 2; v < D.rows; v += kGridStride) {
+    for (int u = kGridStride / 2; u < D.cols; u += kGridStride) {
+      const float z = inside(u, v) ? D.at<float>(v, u) : 0.0f;
+      if (!(z > 0.0f)) continue;
+      // The quarters' sums, the middle row and column left out.
+      double q[2][2] = {{0.0, 0.0}, {0.0, 0.0}};
+      bool whole = true;
+      for (int dv = -w; dv <= w && whole; ++dv) {
+        const float* row = D.ptr<float>(v + dv) + u;
+        for (int du = -w; du <= w; ++du) {
+          if (!sameSurface(row[du], z)) {
+            whole = false;
+            break;
+          }
+          if (du != 0 && dv != 0) q[dv > 0][du > 0] += double(row[du]);
+        }
+      }
+      if (!whole) continue;
+      const double T = (q[0][0] - q[0][1] - q[1][0] + q[1][1]) / quarter;
+      const double t = double(D.at<float>(v, u)) - double(D.at<float>(v, u + 1)) -
+                       double(D.at<float>(v + 1, u)) + double(D.at<float>(v + 1, u + 1));
+      const double inv_z4 = 1.0 / (double(z) * z * z * z);
+      t2.push_back(t * t * inv_z4);
+      T2.push_back(T * T * inv_z4);
+    }
+  }
+  if (T2.empty()) return grid;
+  // Means of the smallest 80%, not of all: a window across a fold (two walls' corner) twists by
+  // its shape. For Gaussian noise that is 0.438 of the variance, for t as for T.
+  auto trimmedMean = [](std::vector<double>& x) {
+    const auto cut = x.begin() + std::ptrdiff_t(std::max<std::size_t>(1, x.size() * 4 / 5));
+    std::nth_element(x.begin(), cut - 1, x.end());
+    double sum = 0.0;
+    for (auto it = x.begin(); it != cut; ++it) sum += *it;
+    return sum / double(cut - x.begin());
+  };
+  const double mt = trimmedMean(t2), mT = trimmedMean(T2);
+  // var(T) = 4 sigma^2 / 9 for noise per pixel: sigma as the windows see it.
+  grid.shared_noise = std::sqrt(double(quarter) * mT / 0.438 / 4.0);
+  grid.independence = mT > 0.0 ? std::min(1.0, mt / (double(quarter) * mT)) : 0.0;
+  const double exact =
+      depth_noise > 0.0 ? std::clamp(1.0 - grid.shared_noise / (kPlaneFade * depth_noise), 0.0, 1.0)
+                        : 1.0;
+  grid.weight = std::max(grid.independence >= kMinIndependence ? grid.independence : 0.0, exact);
+  if (!(grid.weight > 0.0)) return grid;
+  // The window means, over the pixels of the centre's surface.
+  grid.points.reserve(std::size_t(D.rows / kGridStride + 1) * std::size_t(D.cols / kGridStride + 1));
+  for (int v = kGridStride / 2; v < D.rows; v += kGridStride) {
+    for (int u = kGridStride / 2; u < D.cols; u += kGridStride) {
+      const float z = D.at<float>(v, u);
+      if (!(z > 0.0f) || !smoothAround(D, cv::Point(u, v), z)) continue;
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      int n = 0;
+      for (int vv = std::max(0, v - w); vv <= std::min(D.rows - 1, v + w); ++vv) {
+        const float* row = D.ptr<float>(vv);
+        for (int uu = std::max(0, u - w); uu <= std::min(D.cols - 1, u + w); ++uu) {
+          if (!sameSurface(row[uu], z)) continue;
+          sum += camera.backProject(uu, vv, double(row[uu]));
+          ++n;
+        }
+      }
+      if (2 * n >= (2 * w + 1) * (2 * w + 1)) grid.points.push_back(sum / n);
+    }
+  }
+  return grid;
 }
 
 void addReferenceImages(DirectImages& images, const LabelledCloud& cloud) {
   if (images.empty() || !images.intensity.empty() || cloud.gray.empty()) return;
   cloud.gray.convertTo(images.intensity, CV_32F);
   cv::GaussianBlur(images.intensity, images.intensity, cv::Size(0, 0), kSmoothing);
+  if (images.grid.empty()) return;
+  const cv::Mat& D = images.depth;
+  const Camera& c = images.camera;
+  cv::Mat points(D.size(), CV_32FC4, cv::Scalar::all(0.0));
+  for (int v = 0; v < D.rows; ++v) {
+    const float* d = D.ptr<float>(v);
+    auto* out = points.ptr<cv::Vec4f>(v);
+    const float y = float((v - c.cy) / c.fy);
+    for (int u = 0; u < D.cols; ++u) {
+      if (d[u] > 0.0f) out[u] = cv::Vec4f(float((u - c.cx) / c.fx) * d[u], y * d[u], d[u], 1.0f);
+    }
+  }
+  cv::integral(points, images.point_sums, CV_64F);
 }
 
 std::vector<Landing> landings(const DirectImages& reference, const DirectImages& moving_images,
@@ -355,6 +445,64 @@ DirectSums pointToPlaneSums(const DirectImages& reference, const std::vector<Lan
   return sumsOf(residuals, kMinPlaneScale, 0.0, [modelled](double scale) {
     return modelled > 0.0 ? std::clamp(1.0 - scale / (kPlaneFade * modelled), 0.0, 1.0) : 1.0;
   });
+}
+
+namespace {
+
+// The mean point of the window of half size w around (u, v) from an integral image of (x, y,
+// z, 1), and how many points it holds (in count).
+Eigen::Vector3d windowMean(const cv::Mat& sums, int u, int v, int w, double& count) {
+  const cv::Vec4d s = sums.at<cv::Vec4d>(v + w + 1, u + w + 1) -
+                      sums.at<cv::Vec4d>(v - w, u + w + 1) - sums.at<cv::Vec4d>(v + w + 1, u - w) +
+                      sums.at<cv::Vec4d>(v - w, u - w);
+  count = s[3];
+  if (!(count > 0.0)) return Eigen::Vector3d::Zero();
+  return Eigen::Vector3d(s[0], s[1], s[2]) / count;
+}
+
+}  // namespace
+
+DirectSums densePlaneSums(const DirectImages& reference, const DirectImages& moving_images,
+                          const Eigen::Isometry3d& T) {
+  const DepthGrid& grid = moving_images.grid;
+  if (reference.point_sums.empty() || grid.empty() || !(grid.weight > 0.0)) return {};
+  const Camera& cam = reference.camera;
+  const cv::Mat& D = reference.depth;
+  const cv::Mat& S = reference.point_sums;
+  constexpr int w = kGridWindow, r = kNormalReach, margin = kGridWindow + kNormalReach + 1;
+  constexpr double half = 0.5 * (2 * w + 1) * (2 * w + 1);
+  std::vector<Residual> residuals;
+  residuals.reserve(grid.points.size());
+  for (const Eigen::Vector3d& p : grid.points) {
+    const Eigen::Vector3d y = T * p;
+    if (!(y.z() > 0.0)) continue;
+    const int u = int(std::lround(cam.fx * y.x() / y.z() + cam.cx));
+    const int v = int(std::lround(cam.fy * y.y() / y.z() + cam.cy));
+    if (u < margin || v < margin || u + margin >= D.cols || v + margin >= D.rows) continue;
+    const float z = D.at<float>(v, u);
+    // Not occluded; the pixels the plane is taken from all on the same surface.
+    if (!sameSurface(z, float(y.z())) || !sameSurface(D.at<float>(v, u - r), z) ||
+        !sameSurface(D.at<float>(v, u + r), z) || !sameSurface(D.at<float>(v - r, u), z) ||
+        !sameSurface(D.at<float>(v + r, u), z)) {
+      continue;
+    }
+    double n0 = 0.0, n1 = 0.0, n2 = 0.0, n3 = 0.0, n4 = 0.0;
+    const Eigen::Vector3d x = windowMean(S, u, v, w, n0);
+    const Eigen::Vector3d left = x - windowMean(S, u - r, v, w, n1);
+    const Eigen::Vector3d right = windowMean(S, u + r, v, w, n2) - x;
+    const Eigen::Vector3d up = x - windowMean(S, u, v - r, w, n3);
+    const Eigen::Vector3d down = windowMean(S, u, v + r, w, n4) - x;
+    if (std::min({n0, n1, n2, n3, n4}) < half || !sameSurface(float(x.z()), z)) continue;
+    if (!straight(left, right) || !straight(up, down)) continue;
+    const Eigen::Vector3d n = (left + right).cross(up + down).normalized();
+    if (!n.allFinite()) continue;
+    const double inv_z2 = 1.0 / (y.z() * y.z());
+    Residual q{n.dot(y - x) * inv_z2, Vector6d(), 1.0};
+    q.J << inv_z2 * y.cross(n), inv_z2 * n;
+    residuals.push_back(q);
+  }
+  const double weight = grid.weight;
+  return sumsOf(residuals, kMinPlaneScale, 0.0, [weight](double) { return weight; });
 }
 
 }  // namespace acvo
