@@ -71,8 +71,8 @@ struct DirectImages {
   // points are sampled in it.
   cv::Mat intensity;
   // The depth on a grid of pixels (denseGrid; empty when the dense term is off for this depth)
-  // and, for a reference with a grid, the integral image of its points (x, y, z, 1) (CV_64FC4):
-  // the mean point of any window in four reads.
+  // and, for a reference with a grid, the sums of its points (x, y, z, 1) over the 7x7 window
+  // around each pixel (CV_32FC4): a window's mean point in one read.
   DepthGrid grid;
   cv::Mat point_sums;
   bool empty() const { return depth.empty(); }

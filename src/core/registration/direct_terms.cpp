@@ -265,17 +265,25 @@ DepthGrid denseGrid(const cv::Mat& depth, const Camera& camera, double depth_noi
     for (int u = kGridStride / 2; u < D.cols; u += kGridStride) {
       const float z = D.at<float>(v, u);
       if (!(z > 0.0f) || !smoothAround(D, cv::Point(u, v), z)) continue;
-      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      // Sums of u z, v z and z: the mean point is their back-projection.
+      double uz = 0.0, vz = 0.0, sz = 0.0;
       int n = 0;
       for (int vv = std::max(0, v - w); vv <= std::min(D.rows - 1, v + w); ++vv) {
         const float* row = D.ptr<float>(vv);
+        double row_uz = 0.0, row_z = 0.0;
         for (int uu = std::max(0, u - w); uu <= std::min(D.cols - 1, u + w); ++uu) {
           if (!sameSurface(row[uu], z)) continue;
-          sum += camera.backProject(uu, vv, double(row[uu]));
+          row_uz += double(uu) * row[uu];
+          row_z += row[uu];
           ++n;
         }
+        uz += row_uz;
+        vz += double(vv) * row_z;
+        sz += row_z;
       }
-      if (2 * n >= (2 * w + 1) * (2 * w + 1)) grid.points.push_back(sum / n);
+      if (2 * n < (2 * w + 1) * (2 * w + 1)) continue;
+      grid.points.emplace_back((uz - camera.cx * sz) / (camera.fx * n),
+                               (vz - camera.cy * sz) / (camera.fy * n), sz / n);
     }
   }
   return grid;
@@ -297,7 +305,10 @@ void addReferenceImages(DirectImages& images, const LabelledCloud& cloud) {
       if (d[u] > 0.0f) out[u] = cv::Vec4f(float((u - c.cx) / c.fx) * d[u], y * d[u], d[u], 1.0f);
     }
   }
-  cv::integral(points, images.point_sums, CV_64F);
+  // Each pixel's window sum: a box filter's running sums (floats hold 49 points' sums to a
+  // hundredth of a millimetre).
+  cv::boxFilter(points, images.point_sums, CV_32F, cv::Size(2 * kGridWindow + 1, 2 * kGridWindow + 1),
+                cv::Point(-1, -1), false, cv::BORDER_CONSTANT);
 }
 
 std::vector<Landing> landings(const DirectImages& reference, const DirectImages& moving_images,
@@ -449,15 +460,13 @@ DirectSums pointToPlaneSums(const DirectImages& reference, const std::vector<Lan
 
 namespace {
 
-// The mean point of the window of half size w around (u, v) from an integral image of (x, y,
-// z, 1), and how many points it holds (in count).
-Eigen::Vector3d windowMean(const cv::Mat& sums, int u, int v, int w, double& count) {
-  const cv::Vec4d s = sums.at<cv::Vec4d>(v + w + 1, u + w + 1) -
-                      sums.at<cv::Vec4d>(v - w, u + w + 1) - sums.at<cv::Vec4d>(v + w + 1, u - w) +
-                      sums.at<cv::Vec4d>(v - w, u - w);
-  count = s[3];
+// The mean point of the window around (u, v) from the window sums of (x, y, z, 1), and how
+// many points it holds (in count).
+Eigen::Vector3d windowMean(const cv::Mat& sums, int u, int v, double& count) {
+  const cv::Vec4f& s = sums.at<cv::Vec4f>(v, u);
+  count = double(s[3]);
   if (!(count > 0.0)) return Eigen::Vector3d::Zero();
-  return Eigen::Vector3d(s[0], s[1], s[2]) / count;
+  return Eigen::Vector3d(double(s[0]), double(s[1]), double(s[2])) / count;
 }
 
 }  // namespace
@@ -487,11 +496,11 @@ DirectSums densePlaneSums(const DirectImages& reference, const DirectImages& mov
       continue;
     }
     double n0 = 0.0, n1 = 0.0, n2 = 0.0, n3 = 0.0, n4 = 0.0;
-    const Eigen::Vector3d x = windowMean(S, u, v, w, n0);
-    const Eigen::Vector3d left = x - windowMean(S, u - r, v, w, n1);
-    const Eigen::Vector3d right = windowMean(S, u + r, v, w, n2) - x;
-    const Eigen::Vector3d up = x - windowMean(S, u, v - r, w, n3);
-    const Eigen::Vector3d down = windowMean(S, u, v + r, w, n4) - x;
+    const Eigen::Vector3d x = windowMean(S, u, v, n0);
+    const Eigen::Vector3d left = x - windowMean(S, u - r, v, n1);
+    const Eigen::Vector3d right = windowMean(S, u + r, v, n2) - x;
+    const Eigen::Vector3d up = x - windowMean(S, u, v - r, n3);
+    const Eigen::Vector3d down = windowMean(S, u, v + r, n4) - x;
     if (std::min({n0, n1, n2, n3, n4}) < half || !sameSurface(float(x.z()), z)) continue;
     if (!straight(left, right) || !straight(up, down)) continue;
     const Eigen::Vector3d n = (left + right).cross(up + down).normalized();
