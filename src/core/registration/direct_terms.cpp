@@ -260,7 +260,8 @@ DepthGrid denseGrid(const cv::Mat& depth, const Camera& camera, double depth_noi
   grid.weight = std::max(grid.independence >= kMinIndependence ? grid.independence : 0.0, exact);
   if (!(grid.weight > 0.0)) return grid;
   // The window means, over the pixels of the centre's surface.
-  grid.points.reserve(std::size_t(D.rows / kGridStride + 1) * std::size_t(D.cols / kGridStride + 1));
+  grid.points.reserve(std::size_t(D.rows / kGridStride + 1) *
+                      std::size_t(D.cols / kGridStride + 1));
   for (int v = kGridStride / 2; v < D.rows; v += kGridStride) {
     for (int u = kGridStride / 2; u < D.cols; u += kGridStride) {
       const float z = D.at<float>(v, u);
@@ -307,8 +308,9 @@ void addReferenceImages(DirectImages& images, const LabelledCloud& cloud) {
   }
   // Each pixel's window sum: a box filter's running sums (floats hold 49 points' sums to a
   // hundredth of a millimetre).
-  cv::boxFilter(points, images.point_sums, CV_32F, cv::Size(2 * kGridWindow + 1, 2 * kGridWindow + 1),
-                cv::Point(-1, -1), false, cv::BORDER_CONSTANT);
+  constexpr int side = 2 * kGridWindow + 1;
+  cv::boxFilter(points, images.point_sums, CV_32F, cv::Size(side, side), cv::Point(-1, -1), false,
+                cv::BORDER_CONSTANT);
 }
 
 std::vector<Landing> landings(const DirectImages& reference, const DirectImages& moving_images,
