@@ -2,7 +2,8 @@
 // of real frames (see frame_pair.hpp): pixel selection, cloud building, the depth moved to the
 // colour's time; for the default engine
 // a reference's search grids, the kernel pass of a level (fresh and with warm candidate lists),
-// the last level's direct terms and a whole registration; for the paper's engine the cloud preparation (search grid and
+// the last level's direct terms, a frame's depth grid for the dense term and a whole
+// registration; for the paper's engine the cloud preparation (search grid and
 // self-kernel pairs), its kernel pass, the step-size sums, the self-kernel sums and a whole
 // registration.
 //
@@ -187,6 +188,20 @@ void BM_DirectTerms(benchmark::State& state) {
   state.counters["residuals"] = used;
 }
 BENCHMARK(BM_DirectTerms)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// A frame's depth grid for the dense term: the twists that decide it, and the window means where
+// it is on (real Kinect frames: off, the twists alone; the synthetic pair, noise per pixel: on).
+void BM_DenseGrid(benchmark::State& state) {
+  const acvo::LabelledCloud& c = g_pair->moving->cloud;
+  acvo::DepthGrid grid;
+  for (auto _ : state) {
+    grid = acvo::denseGrid(c.depth, c.camera, g_pair->params.coarse_to_fine.depth_noise);
+    benchmark::DoNotOptimize(grid.points.data());
+  }
+  state.counters["independence"] = grid.independence;
+  state.counters["points"] = double(grid.points.size());
+}
+BENCHMARK(BM_DenseGrid)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // A whole registration of the default engine from the identity guess.
 void BM_Align(benchmark::State& state) {
