@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -64,6 +65,10 @@ struct SolverResult {
   // ... and the vignetting it measured: exp(vignetting rho) the camera's falloff towards the
   // corners, rho the squared distance from the principal point in focal lengths (0 without).
   double vignetting = 0.0;
+  // ... and its dense point-to-plane term's weight at the last level (DepthGrid::weight: 0 where
+  // the depth's noise does not average away or its stamp is not the colour's; NaN where the
+  // term is not part of the engine or is turned off).
+  double dense_weight = std::numeric_limits<double>::quiet_NaN();
   std::vector<IterationTrace> trace;
   // Time per stage, milliseconds.
   double ms_total = 0.0;

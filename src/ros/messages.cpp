@@ -1,6 +1,8 @@
 #include "messages.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 
 #include <diagnostic_msgs/DiagnosticStatus.h>
 #include <tf2_eigen/tf2_eigen.h>
@@ -99,6 +101,18 @@ DiagnosticSummary summarise(bool synchronised, double seconds_since_frame, doubl
       break;
   }
   return {DiagnosticStatus::ERROR, "bad input"};
+}
+
+std::string denseWeightText(double weight, double depth_delay) {
+  if (std::isnan(weight)) return "not in use";
+  if (weight > 0.0) {
+    char text[16];
+    std::snprintf(text, sizeof text, "%.2f", weight);
+    return text;
+  }
+  if (depth_delay != 0.0) return "0 (off: the depth's stamp is not the colour's)";
+  return "0 (off: the depth's noise is shared between neighbouring pixels, as a structured-light "
+         "camera's)";
 }
 
 }  // namespace acvo_ros

@@ -50,4 +50,9 @@ struct DiagnosticSummary {
 DiagnosticSummary summarise(bool synchronised, double seconds_since_frame, double no_data_timeout,
                             acvo::Tracking last, bool paused = false);
 
+// What diagnostics say of the dense depth term (SolverResult::dense_weight) on the last frame:
+// its weight, or why it is off: "not in use" (NaN: another engine, or turned off), the depth's
+// stamp not the colour's (depth_delay s), or its noise shared between neighbouring pixels.
+std::string denseWeightText(double weight, double depth_delay);
+
 }  // namespace acvo_ros

@@ -159,6 +159,8 @@ class OdometryNodelet : public nodelet::Nodelet {
     bool depth_synced = false;  // the depth was moved to the colour's time
     // The velocity filter's weight of the frame's own velocity (rotation, translation; NaN: none).
     Eigen::Vector2d own_velocity_weight = Eigen::Vector2d::Constant(std::nan(""));
+    // The dense depth term's weight (NaN: not in use).
+    double dense_weight = std::nan("");
     ros::WallTime wall;  // last synchronised frame, good or bad
   };
 
@@ -387,6 +389,7 @@ void OdometryNodelet::processFrame(const Image& rgb, const Image& depth, const I
   last_.depth_delay = r.depth_delay;
   last_.depth_synced = r.depth_synced || r.depth_retimed;
   last_.own_velocity_weight = r.own_velocity_weight;
+  last_.dense_weight = r.solver.dense_weight;
   if (last_.depth_synced && !depth_sync_told_) {
     depth_sync_told_ = true;
     NODELET_INFO("colour and depth stamps differ (%.1f ms on this frame): each frame's depth is "
@@ -782,6 +785,7 @@ void OdometryNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat
     }
   }
   stat.addf("colour stamp - depth stamp (ms)", "%.2f%s", 1e3 * last_.depth_delay, moved.c_str());
+  stat.add("dense depth term weight", denseWeightText(last_.dense_weight, last_.depth_delay));
   stat.add("parameter problems",
            parameter_problems_.empty() ? std::string("none") : parameter_problems_);
   stat.add("messages received (rgb, depth, info)", std::to_string(count_.rgb.load()) + ", " +

@@ -689,6 +689,16 @@ TEST(InfoMsg, CarriesTheResult) {
   EXPECT_EQ(info.interval, 0.066);
 }
 
+// The dense depth term: its weight, or why it is off.
+TEST(Diagnostics, DenseDepthTermSaysItsWeightOrWhyItIsOff) {
+  EXPECT_EQ(denseWeightText(0.902, 0.0), "0.90");
+  EXPECT_EQ(denseWeightText(1.0, 0.0), "1.00");
+  EXPECT_EQ(denseWeightText(std::nan(""), 0.0), "not in use");
+  EXPECT_EQ(denseWeightText(0.0, 0.012), "0 (off: the depth's stamp is not the colour's)");
+  EXPECT_NE(denseWeightText(0.0, 0.0).find("shared between neighbouring pixels"),
+            std::string::npos);
+}
+
 TEST(Diagnostics, NoDataFirstThenTheLastFramesJudgement) {
   using diagnostic_msgs::DiagnosticStatus;
   EXPECT_EQ(summarise(false, 0.0, 3.0, acvo::Tracking::kOk).message, "no data");

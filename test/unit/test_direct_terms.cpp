@@ -475,6 +475,27 @@ TEST(DirectTerms, MakeTheDefaultEngineFinerThanItsKernel) {
   }
 }
 
+// The engine reports the dense term's weight: the moving grid's on noise per pixel, 0 on noise in
+// blobs, NaN when the term is turned off.
+TEST(DirectTerms, TheEngineReportsTheDenseTermsWeight) {
+  auto weightOn = [](const Pair& p, bool dense) {
+    CoarseToFineParams params;
+    params.dense_point_to_plane = dense;
+    const auto A = prepareCoarseToFine(p.a, params, true);
+    const auto B = prepareCoarseToFine(p.b, params, false);
+    const double w =
+        alignCoarseToFine(*A, *B, Eigen::Isometry3d::Identity(), params).dense_weight;
+    if (dense) {
+      EXPECT_EQ(w, B->images.grid.weight);
+    }
+    return w;
+  };
+  const Pair per_pixel = renderedPair(false, true);
+  EXPECT_GT(weightOn(per_pixel, true), kMinIndependence);
+  EXPECT_TRUE(std::isnan(weightOn(per_pixel, false)));
+  EXPECT_EQ(weightOn(renderedPair(false, true, 1.0, 0.0, 3.0), true), 0.0);
+}
+
 // The engine in two calls, the stages before the finest and then the finest from where they
 // left off, registers as one call does (Odometry moves the depth again in between).
 TEST(DirectTerms, TheEngineInTwoStagesIsTheEngineInOne) {
