@@ -40,11 +40,13 @@ namespace acvo {
 // var(t) = 9 var(T), noise in blobs var(t) << 9 var(T).
 struct DepthGrid {
   std::vector<Eigen::Vector3d> points;  // the window means, camera frame
-  // var(t) / (9 var(T)), in [0, 1]: near 1 for noise drawn per pixel, 0.05-0.12 on real Kinect
-  // frames and on rendered noise in 3-px blobs.
+  // var(t) / (9 var(T)), in [0, 1], each variance as the mean of the smallest 80% of the
+  // squares (a window across a fold twists by its shape): about 0.9 for noise drawn per pixel,
+  // 0-0.12 on real Kinect frames and on rendered noise in 3-px blobs.
   double independence = 0.0;
   // sqrt(9 var(T) / 4) / z^2: the standard deviation of a pixel's noise that a window does not
-  // average away, in units of depth_noise (1/m).
+  // average away, in units of depth_noise (1/m) (var(T) from the trimmed mean of T^2, 0.438 of
+  // the variance for Gaussian noise).
   double shared_noise = 0.0;
   // The weight of the term: the independence where it is at least kMinIndependence, else how
   // far the shared noise is under the modelled depth noise (1 - shared_noise / (kPlaneFade
@@ -92,7 +94,7 @@ DirectImages directImages(const LabelledCloud& cloud, bool dense = false, double
 // modelled depth_noise; no points when the weight is 0.
 DepthGrid denseGrid(const cv::Mat& depth, const Camera& camera, double depth_noise);
 // What a reference needs more: its whole smoothed grey image and, when it has a depth grid, its
-// points' integral image (none when `images` is empty).
+// points' window sums (none when `images` is empty).
 void addReferenceImages(DirectImages& images, const LabelledCloud& cloud);
 
 // Where a moving point lands in the reference: point j, its position y there and its pixel
@@ -189,10 +191,13 @@ Brightness brightnessOf(const std::vector<GreyPair>& pairs, bool gain, bool vign
 constexpr double kPlaneFade = 0.5;
 DirectSums pointToPlaneSums(const DirectImages& reference, const std::vector<Landing>& landed,
                             double depth_noise);
+// The dense term's weight between a reference and a moving cloud: the moving grid's, 0 when
+// either has no grid (the reference's window sums are built only with its own grid).
+double denseWeight(const DirectImages& reference, const DirectImages& moving_images);
 // r_k = n^T (T g_k - x) / z_k^2 for the moving grid's points g_k (DepthGrid), x the mean point
 // of the reference's window where T g_k projects and n the normal from the means kNormalReach
-// pixels to each side, where the reference's surface does not fold there; weighed by the
-// moving grid's weight. Nothing when either has no grid.
+// pixels to each side, where the reference's surface does not fold there; weighed by
+// denseWeight. Nothing where that is 0.
 DirectSums densePlaneSums(const DirectImages& reference, const DirectImages& moving_images,
                           const Eigen::Isometry3d& T);
 

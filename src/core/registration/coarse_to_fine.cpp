@@ -203,10 +203,7 @@ SolverResult alignCoarseToFine(const CoarseToFineCloud& fixed, const CoarseToFin
     LevelDirect direct;
     if (last && directTerms(p) && fixed.images.isReference() && !moving.images.empty()) {
       direct = {&fixed.images, &moving.images, &moving.cloud};
-      if (p.dense_point_to_plane) {
-        const bool both = !fixed.images.point_sums.empty() && !moving.images.grid.empty();
-        result.dense_weight = both ? moving.images.grid.weight : 0.0;
-      }
+      if (p.dense_point_to_plane) result.dense_weight = denseWeight(fixed.images, moving.images);
     }
     if (!iterateLevel(*kernel, direct, ell, eps, last, p, T, result)) {
       result.status = SolverStatus::kNotFinite;

@@ -26,6 +26,12 @@ constexpr double kMinPlaneScale = 1e-5;
 // Depths that differ by more than this fraction belong to different surfaces.
 constexpr float kSameSurface = 0.05f;
 
+// How much depth whose noise is `scale` is worth against the modelled noise `modelled`: 1 - scale /
+// (kPlaneFade modelled), none beyond; full weight when the model says the depth is exact (0).
+double planeFade(double scale, double modelled) {
+  return modelled > 0.0 ? std::clamp(1.0 - scale / (kPlaneFade * modelled), 0.0, 1.0) : 1.0;
+}
+
 bool sameSurface(float a, float b) {
   return a > 0.0f && b > 0.0f && std::abs(a - b) <= kSameSurface * std::min(a, b);
 }
@@ -254,9 +260,7 @@ DepthGrid denseGrid(const cv::Mat& depth, const Camera& camera, double depth_noi
   // var(T) = 4 sigma^2 / 9 for noise per pixel: sigma as the windows see it.
   grid.shared_noise = std::sqrt(double(quarter) * mT / 0.438 / 4.0);
   grid.independence = mT > 0.0 ? std::min(1.0, mt / (double(quarter) * mT)) : 0.0;
-  const double exact =
-      depth_noise > 0.0 ? std::clamp(1.0 - grid.shared_noise / (kPlaneFade * depth_noise), 0.0, 1.0)
-                        : 1.0;
+  const double exact = planeFade(grid.shared_noise, depth_noise);
   grid.weight = std::max(grid.independence >= kMinIndependence ? grid.independence : 0.0, exact);
   if (!(grid.weight > 0.0)) return grid;
   // The window means, over the pixels of the centre's surface.
@@ -455,9 +459,8 @@ DirectSums pointToPlaneSums(const DirectImages& reference, const std::vector<Lan
   }
   // Both points' depth noise, as the kernel assumes it.
   const double modelled = std::sqrt(2.0) * depth_noise;
-  return sumsOf(residuals, kMinPlaneScale, 0.0, [modelled](double scale) {
-    return modelled > 0.0 ? std::clamp(1.0 - scale / (kPlaneFade * modelled), 0.0, 1.0) : 1.0;
-  });
+  return sumsOf(residuals, kMinPlaneScale, 0.0,
+                [modelled](double scale) { return planeFade(scale, modelled); });
 }
 
 namespace {
@@ -473,10 +476,16 @@ Eigen::Vector3d windowMean(const cv::Mat& sums, int u, int v, double& count) {
 
 }  // namespace
 
+double denseWeight(const DirectImages& reference, const DirectImages& moving_images) {
+  const bool both = !reference.point_sums.empty() && !moving_images.grid.empty();
+  return both ? moving_images.grid.weight : 0.0;
+}
+
 DirectSums densePlaneSums(const DirectImages& reference, const DirectImages& moving_images,
                           const Eigen::Isometry3d& T) {
+  const double weight = denseWeight(reference, moving_images);
+  if (!(weight > 0.0)) return {};
   const DepthGrid& grid = moving_images.grid;
-  if (reference.point_sums.empty() || grid.empty() || !(grid.weight > 0.0)) return {};
   const Camera& cam = reference.camera;
   const cv::Mat& D = reference.depth;
   const cv::Mat& S = reference.point_sums;
@@ -512,7 +521,6 @@ DirectSums densePlaneSums(const DirectImages& reference, const DirectImages& mov
     q.J << inv_z2 * y.cross(n), inv_z2 * n;
     residuals.push_back(q);
   }
-  const double weight = grid.weight;
   return sumsOf(residuals, kMinPlaneScale, 0.0, [weight](double) { return weight; });
 }
 
