@@ -363,6 +363,24 @@ TEST(DirectTerms, DenseGridTellsNoisePerPixelFromNoiseInBlobs) {
   EXPECT_TRUE(directImages(per_pixel, false, kDepthNoise).grid.empty());
 }
 
+// Depth with nothing to measure: no valid pixel, NaN everywhere, an image smaller than a window;
+// and a flat wall at one depth, exact: full weight.
+TEST(DirectTerms, DenseGridOfBlankOrTinyDepth) {
+  const Camera camera;
+  const cv::Mat nan(480, 640, CV_32FC1, cv::Scalar(std::nan("")));
+  for (const cv::Mat& depth : {cv::Mat(cv::Mat::zeros(480, 640, CV_32FC1)), nan,
+                               cv::Mat(cv::Mat(4, 4, CV_32FC1, cv::Scalar(2.0f)))}) {
+    const DepthGrid g = denseGrid(depth, camera, kDepthNoise);
+    EXPECT_TRUE(g.empty());
+    EXPECT_EQ(g.weight, 0.0);
+  }
+  const DepthGrid wall = denseGrid(cv::Mat(480, 640, CV_32FC1, cv::Scalar(2.0f)), camera,
+                                   kDepthNoise);
+  EXPECT_EQ(wall.weight, 1.0);
+  ASSERT_FALSE(wall.empty());
+  for (const Eigen::Vector3d& p : wall.points) EXPECT_NEAR(p.z(), 2.0, 1e-6);
+}
+
 // The dense term alone converges to the true motion: on exact depth to a few hundredths of a
 // millimetre, on noise per pixel to a fraction of the sparse term's error there.
 TEST(DirectTerms, DensePlaneAloneConverges) {
