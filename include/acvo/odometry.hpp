@@ -11,6 +11,7 @@
 
 #include <Eigen/Geometry>
 
+#include "acvo/colour_depth_check.hpp"
 #include "acvo/covariance.hpp"
 #include "acvo/frame.hpp"
 #include "acvo/labelled_cloud.hpp"
@@ -77,6 +78,11 @@ struct OdometryResult {
   double ms_prepare = 0.0;
   double ms_registration = 0.0;  // the solver (both registrations when it fell back)
   CloudStats cloud_stats;
+  // The colour check's verdict became known with this frame (Odometry::colourCheck()), and
+  // whether this frame's colour was resampled to the depth camera
+  // (OdometryParams::resample_unregistered_colour; from the frame after the verdict).
+  bool colour_verdict_now = false;
+  bool colour_resampled = false;
 };
 
 // Tracking judgement of a registration, from the solver's result and the motion it implies
@@ -145,7 +151,9 @@ class Odometry {
   // Processes one frame. A frame with a problem (Frame::problem()) is rejected with
   // Tracking::kBadFrame and does not change the state. `motion_guess`, when given, replaces
   // the motion prior: the motion from this frame's camera to the last tracked frame's
-  // (T: current -> last, as OdometryResult::motion), e.g. from wheel odometry.
+  // (T: current -> last, as OdometryResult::motion), e.g. from wheel odometry. Once the colour
+  // check has found the colour unregistered, the frame's colour is resampled first
+  // (colourResampling); `frame` itself is never changed.
   OdometryResult process(const Frame& frame,
                          const std::optional<Eigen::Isometry3d>& motion_guess = std::nullopt);
 
@@ -160,6 +168,19 @@ class Odometry {
   std::optional<double> lastTrackedStamp() const;
   // The current keyframe's cloud, if any.
   const LabelledCloud* keyframeCloud() const;
+  // Whether depth and colour look registered, from every ColourDepthCheck::kFrameStep-th frame
+  // (as registered: depthAsRegistered) until it decides; and the focal ratio each frame's
+  // colour is resampled by since (an unregistered verdict, resample_unregistered_colour), if
+  // any. Neither changes with reset(): they concern the camera.
+  const ColourDepthCheck& colourCheck() const { return colour_check_; }
+  std::optional<double> colourResampling() const { return colour_ratio_; }
+  // The check's verdict for a log (ColourDepthCheck::describe), and what is done about it.
+  std::string describeColour() const;
+  // Another camera: the check looks again and the colour is used again until it decides.
+  void newCamera();
+  // Takes over a check made on this camera (another Odometry's, before a parameter change),
+  // and acts on its verdict.
+  void takeColourCheck(const ColourDepthCheck& check);
 
  private:
   // A frame with a known pose, kept as the keyframe or as the last tracked frame.
@@ -172,7 +193,16 @@ class Odometry {
     Matrix6d to_keyframe_covariance = Matrix6d::Zero();             // of to_keyframe
   };
   struct Registration;
-  // The steps of process(), in order.
+  // process() but for the colour check.
+  OdometryResult track(const Frame& frame, const std::optional<Eigen::Isometry3d>& motion_guess);
+  // Gives the frame to the colour check when its turn comes; when the check finds the colour
+  // unregistered, resamples it from then on (actOnColourVerdict) and makes this frame the
+  // keyframe, its cloud rebuilt from its resampled colour.
+  void checkColour(const Frame& frame, OdometryResult& r);
+  // The colour resampling for the check's verdict (resample_unregistered_colour), and the
+  // engine without the photometric term while it lasts.
+  void actOnColourVerdict();
+  // The steps of track(), in order.
   // The camera's motion over `seconds`, as the last frame-to-frame motion says; none until two
   // frames were tracked.
   std::optional<Eigen::Isometry3d> motionOver(double seconds) const;
@@ -219,6 +249,9 @@ class Odometry {
   std::optional<Tracked> last_;  // the last tracked frame (the keyframe itself, or after it)
   int lost_in_a_row_ = 0;
   std::uint64_t frames_ = 0;  // frames numbered so far
+  ColourDepthCheck colour_check_;
+  // Each frame's colour is resampled by it (colourResampling).
+  std::optional<double> colour_ratio_;
   struct Arena;               // the thread pool the solver runs in (odometry.threads)
   std::unique_ptr<Arena> arena_;
 };

@@ -165,6 +165,13 @@ struct OdometryParams {
   // it (VelocityFilter), so that each point's colour and position are of one instant. Off: the
   // two are paired as they come.
   bool sync_depth = true;
+  // Once the colour check (ColourDepthCheck) finds the depth not registered to the colour (a
+  // second camera's colour, 7-Scenes'), each frame's colour is resampled to the depth camera's
+  // focal length, by the ratio the check found (withColourResampled): a colour left off its
+  // points puts the points chosen at its edges where the texture appears, which slides along
+  // the surfaces with the motion (docs/accuracy.md, sixth and fourteenth rounds). Off: the
+  // colour is used as it comes, with the check's warning.
+  bool resample_unregistered_colour = true;
 };
 
 struct Params {
@@ -262,6 +269,7 @@ void visitParams(Params_& p, Visitor&& visit) {
   visit("odometry", "lost_speed", p.odometry.lost_speed);
   visit("odometry", "lost_angular_speed", p.odometry.lost_angular_speed);
   visit("odometry", "sync_depth", p.odometry.sync_depth);
+  visit("odometry", "resample_unregistered_colour", p.odometry.resample_unregistered_colour);
 }
 
 // The paper's A-CVO as the authors' code runs it (config/paper.yaml; docs/method.md §4 says

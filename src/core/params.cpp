@@ -240,6 +240,7 @@ Params paperParams() {
   p.odometry.lost_matched_fraction = 0.0;
   p.odometry.hard_matched_fraction = 0.05;
   p.odometry.sync_depth = false;  // colour and depth paired as they come
+  p.odometry.resample_unregistered_colour = false;  // and the colour used as it comes
   return p;
 }
 

@@ -95,7 +95,8 @@ class OdometryNodelet : public nodelet::Nodelet {
   void processFrame(const Image& rgb, const Image& depth, const Info& info);
   bool acceptStamp(const ros::Time& stamp);
   void reject(const std_msgs::Header& header, const std::string& why, double ms_total);
-  void checkRegistration(const acvo::Frame& frame);
+  // Logs the colour check's verdict when it comes (Odometry::colourCheck).
+  void logColourVerdict(const acvo::OdometryResult& r);
   std::string baseFrame() const;
   bool baseIsCamera() const;
   std::optional<Eigen::Isometry3d> lookup(const std::string& target, const std::string& source,
@@ -178,9 +179,6 @@ class OdometryNodelet : public nodelet::Nodelet {
   bool base_waited_ = false;  // waited once for base_from_camera_ (per camera frame)
   bool frame_ids_warned_ = false;
   bool depth_sync_told_ = false;  // said once that colour and depth stamps differ
-  // Whether the depth is registered to the colour, from the images themselves: every
-  // kFrameStep-th processed frame until it decides, then once in the log.
-  acvo::ColourDepthCheck colour_check_;
   ContinuousOdom continuous_;  // the published pose (odom_continuity.hpp)
   // A base pose to start from (initial_pose, or reset_odom_to_pose before the camera-to-base
   // transform was known): applied at the first frame whose transform is known.
@@ -367,7 +365,7 @@ void OdometryNodelet::processFrame(const Image& rgb, const Image& depth, const I
   }
   if (header.frame_id != camera_frame_) {
     camera_frame_ = header.frame_id;
-    colour_check_ = acvo::ColourDepthCheck();  // another camera: look again
+    odometry_->newCamera();  // the colour check looks again
     base_from_camera_.reset();
     base_waited_ = false;
   }
@@ -379,7 +377,7 @@ void OdometryNodelet::processFrame(const Image& rgb, const Image& depth, const I
   }
   acvo::OdometryResult r = odometry_->process(frame, tf.motion_guess);
   ++count_.frames;
-  checkRegistration(acvo::depthAsRegistered(frame, r));
+  logColourVerdict(r);
   if (!tf.base_from_camera && r.tracking != acvo::Tracking::kBadFrame) {
     r.message += std::string(r.message.empty() ? "" : "; ") + "not published: no transform from '" +
                  baseFrame() + "' to '" + camera_frame_ + "' yet";
@@ -463,13 +461,13 @@ bool OdometryNodelet::acceptStamp(const ros::Time& stamp) {
   return false;
 }
 
-void OdometryNodelet::checkRegistration(const acvo::Frame& frame) {
-  if (colour_check_.decided() || count_.frames % acvo::ColourDepthCheck::kFrameStep != 1) return;
-  colour_check_.add(frame);
-  if (colour_check_.verdict().state == acvo::ColourDepthCheck::State::kUnregistered) {
-    NODELET_WARN("%s", colour_check_.describe().c_str());
-  } else if (colour_check_.decided()) {
-    NODELET_INFO("%s", colour_check_.describe().c_str());
+void OdometryNodelet::logColourVerdict(const acvo::OdometryResult& r) {
+  if (!r.colour_verdict_now) return;
+  const std::string text = odometry_->describeColour();
+  if (odometry_->colourCheck().verdict().state == acvo::ColourDepthCheck::State::kUnregistered) {
+    NODELET_WARN("%s", text.c_str());
+  } else {
+    NODELET_INFO("%s", text.c_str());
   }
 }
 
@@ -726,9 +724,11 @@ void OdometryNodelet::onReconfigure(acvo::AcvoConfig& config, uint32_t /*level*/
     if (describeParams(next) == describeParams(params_)) return;
     const Eigen::Isometry3d pose = odometry_->pose();
     const acvo::Matrix6d covariance = odometry_->poseCovariance();
+    const acvo::ColourDepthCheck check = odometry_->colourCheck();  // the camera is the same
     params_ = next;
     odometry_ = std::make_unique<acvo::Odometry>(params_);
     odometry_->reset(pose, covariance);
+    odometry_->takeColourCheck(check);
     published_keyframe_.reset();
     NODELET_INFO("parameters changed, tracking restarts from the current pose: %s",
                  describeParams(params_).c_str());
@@ -773,7 +773,9 @@ void OdometryNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat
   stat.add("last message", last_.message);
   stat.add("last ms total", last_.ms_total);
   stat.add("last ms latency", last_.ms_latency);
-  stat.add("colour/depth registration", acvo::toString(colour_check_.verdict().state));
+  stat.add("colour/depth registration",
+           acvo::toString(odometry_->colourCheck().verdict().state) +
+               (odometry_->colourResampling() ? " (colour resampled to the depth camera)" : ""));
   std::string moved;
   if (last_.depth_synced) {
     moved = ", depth moved to the colour's time";

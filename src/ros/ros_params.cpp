@@ -174,6 +174,7 @@ acvo::AcvoConfig toConfig(const acvo::Params& params, LostOdom lost_odom) {
   c.paper_max_iterations = params.paper.max_iterations;
   c.initial_guess = acvo::toString(params.odometry.initial_guess);
   c.sync_depth = params.odometry.sync_depth;
+  c.resample_unregistered_colour = params.odometry.resample_unregistered_colour;
   c.lost_odom = toString(lost_odom);
   return c;
 }
@@ -202,6 +203,7 @@ acvo::Params fromConfig(const acvo::AcvoConfig& config, acvo::Params base) {
   base.paper.max_iterations = config.paper_max_iterations;
   acvo::fromString(config.initial_guess, base.odometry.initial_guess);
   base.odometry.sync_depth = config.sync_depth;
+  base.odometry.resample_unregistered_colour = config.resample_unregistered_colour;
   return base;
 }
 

@@ -120,7 +120,6 @@ int main(int argc, char** argv) {
     odometry.reset(world_from_first);
 
     const bool progress = isatty(STDERR_FILENO);
-    acvo::ColourDepthCheck colour_check;
     acvo::Trajectory trajectory;
     std::vector<double> frame_ms;
     long failures = 0;
@@ -130,11 +129,11 @@ int main(int argc, char** argv) {
       try {
         const acvo::Frame frame = data.loadFrame(std::size_t(k));
         r = odometry.process(frame);
-        if (!colour_check.decided() && (k - first) % acvo::ColourDepthCheck::kFrameStep == 0 &&
-            colour_check.add(acvo::depthAsRegistered(frame, r)).state ==
-                acvo::ColourDepthCheck::State::kUnregistered) {
-          std::cerr << (progress ? "\n" : "") << "acvo_tum: warning: " << colour_check.describe()
-                    << "\n";
+        if (r.colour_verdict_now) {
+          const bool unregistered = odometry.colourCheck().verdict().state ==
+                                    acvo::ColourDepthCheck::State::kUnregistered;
+          std::cerr << (progress ? "\n" : "") << "acvo_tum: " << (unregistered ? "warning: " : "")
+                    << odometry.describeColour() << "\n";
         }
       } catch (const std::exception& e) {
         std::cerr << "\nacvo_tum: frame " << k << " skipped: " << e.what() << "\n";

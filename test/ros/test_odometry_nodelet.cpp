@@ -1444,11 +1444,12 @@ TEST(OdometryNodelet, ABadParameterIsRejectedAloneAndAnUnknownOneIsNamed) {
   EXPECT_EQ(problems->find("target_points"), std::string::npos) << *problems;
 }
 
-// Whether the depth is registered to the colour is judged from the images (every 3rd frame,
+// Whether the depth is registered to the colour is judged from the images (every frame until
 // 10 with enough depth edges): the registered room of the tests before says so in diagnostics
 // without a warning. A camera whose colour comes from a second camera with 0.897 times the focal
 // length (7-Scenes', a raw depth image's) is judged again from its first frame and named with
-// what to do; its frames are still processed.
+// what to do; its frames are still processed, their colour resampled to the depth camera from
+// then on (odometry/resample_unregistered_colour).
 TEST(OdometryNodelet, DepthNotRegisteredToTheColourIsNamed) {
   const ros::WallTime since = ros::WallTime::now();
   ASSERT_TRUE(client->reset());
@@ -1479,7 +1480,9 @@ TEST(OdometryNodelet, DepthNotRegisteredToTheColourIsNamed) {
   const auto at = warning->find("focal length ");
   ASSERT_NE(at, std::string::npos) << *warning;
   EXPECT_NEAR(std::stod(warning->substr(at + 13, 4)), 0.897, 0.03) << *warning;  // found: 0.91
-  EXPECT_EQ(judged("unregistered"), "unregistered");
+  EXPECT_NE(warning->find("resampled"), std::string::npos) << *warning;
+  const std::string resampled = "unregistered (colour resampled to the depth camera)";
+  EXPECT_EQ(judged(resampled), resampled);
 }
 
 bool setSyncDepth(bool on) {

@@ -330,6 +330,75 @@ TEST(Odometry, ResetStartsAgainFromTheGivenPose) {
   EXPECT_TRUE(r.pose.isApprox(start));
 }
 
+// Colour from a second camera (0.897 times the depth's focal length, exact depth): the colour
+// check decides at the tenth frame; that frame becomes the keyframe, its cloud built again from
+// the resampled colour (a grey value at a selected pixel tells which), and every frame after
+// it is resampled by the ratio found. The frames given are not changed. reset() keeps the
+// verdict, which concerns the camera; newCamera() drops it, takeColourCheck() carries it to
+// another Odometry (a parameter change). With resample_unregistered_colour off, the verdict
+// alone. A registered camera: the verdict, nothing resampled.
+TEST(Odometry, ColourFromASecondCameraIsResampledFromTheVerdictOn) {
+  synth::SequenceOptions o;
+  o.frames = 16;
+  o.noise = false;
+  o.colour_focal_ratio = 0.897;
+  const synth::SynthSequence seq(o);
+  Odometry odo;
+  odo.reset(seq.poses()[0]);
+  int verdict_at = -1;
+  for (int i = 0; i < seq.size(); ++i) {
+    const Frame frame = seq.frame(i).toFrame();
+    const cv::Mat given = frame.color.clone();
+    const OdometryResult r = odo.process(frame);
+    EXPECT_EQ(cv::countNonZero(frame.color.reshape(1) != given.reshape(1)), 0) << i;
+    EXPECT_NE(r.tracking, Tracking::kLost) << i;
+    if (r.colour_verdict_now) {
+      verdict_at = i;
+      EXPECT_TRUE(r.new_keyframe);
+      EXPECT_FALSE(r.colour_resampled);  // registered as it came, then rebuilt
+      // The keyframe's colour is the resampled frame's.
+      const Frame resampled = withColourResampled(frame, *odo.colourResampling());
+      const LabelledCloud& key = *odo.keyframeCloud();
+      ASSERT_FALSE(key.pixels.empty());
+      const cv::Point p = key.pixels[key.pixels.size() / 2];
+      EXPECT_EQ(key.gray.at<std::uint8_t>(p), grayImage(resampled).at<std::uint8_t>(p));
+    }
+    EXPECT_EQ(r.colour_resampled, verdict_at >= 0 && i > verdict_at) << i;
+  }
+  EXPECT_EQ(verdict_at, 9);
+  ASSERT_EQ(odo.colourCheck().verdict().state, ColourDepthCheck::State::kUnregistered);
+  ASSERT_TRUE(odo.colourResampling());
+  EXPECT_NEAR(*odo.colourResampling(), 0.897, 0.025);
+  EXPECT_NE(odo.describeColour().find("resampled"), std::string::npos) << odo.describeColour();
+
+  odo.reset(seq.poses()[0]);
+  EXPECT_TRUE(odo.colourResampling());
+  Odometry next;
+  next.takeColourCheck(odo.colourCheck());
+  EXPECT_EQ(next.colourResampling(), odo.colourResampling());
+  EXPECT_TRUE(next.process(seq.frame(0).toFrame()).colour_resampled);
+  next.newCamera();
+  EXPECT_FALSE(next.colourResampling());
+  EXPECT_FALSE(next.colourCheck().decided());
+
+  Params keep;
+  keep.odometry.resample_unregistered_colour = false;
+  Odometry as_it_comes(keep);
+  for (int i = 0; i < seq.size(); ++i) {
+    EXPECT_FALSE(as_it_comes.process(seq.frame(i).toFrame()).colour_resampled);
+  }
+  EXPECT_EQ(as_it_comes.colourCheck().verdict().state, ColourDepthCheck::State::kUnregistered);
+  EXPECT_FALSE(as_it_comes.colourResampling());
+
+  const auto registered = exactSequence(16);
+  Odometry plain;
+  for (int i = 0; i < registered.size(); ++i) {
+    EXPECT_FALSE(plain.process(registered.frame(i).toFrame()).colour_resampled);
+  }
+  EXPECT_EQ(plain.colourCheck().verdict().state, ColourDepthCheck::State::kRegistered);
+  EXPECT_FALSE(plain.colourResampling());
+}
+
 TEST(Odometry, DeterministicForTheSameFramesWhateverTheThreadCount) {
   const auto seq = exactSequence(4);
   Eigen::Isometry3d last[2];

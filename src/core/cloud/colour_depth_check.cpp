@@ -148,4 +148,27 @@ std::string toString(ColourDepthCheck::State state) {
   return "undecided";
 }
 
+Frame withColourResampled(const Frame& frame, double ratio) {
+  if (frame.color.empty() || ratio == 1.0 || !(ratio > 0.0)) return frame;
+  const Camera& c = frame.camera;
+  // Scaling about the principal point: cv::warpAffine with the map from each output pixel to
+  // where it is read.
+  const cv::Matx23d to_colour(ratio, 0.0, c.cx * (1.0 - ratio), 0.0, ratio, c.cy * (1.0 - ratio));
+  Frame out = frame;
+  out.color = cv::Mat();  // a new image: the frame's own is shared, not written
+  cv::warpAffine(frame.color, out.color, to_colour, frame.color.size(),
+                 cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_REPLICATE);
+  if (ratio > 1.0 && !frame.depth.empty()) {
+    out.depth = frame.depth.clone();
+    for (int v = 0; v < out.depth.rows; ++v) {
+      const double y = c.cy + ratio * (v - c.cy);
+      auto* d = out.depth.ptr<float>(v);
+      for (int u = 0; u < out.depth.cols; ++u) {
+        if (!inside(frame.color, c.cx + ratio * (u - c.cx), y)) d[u] = 0.0f;
+      }
+    }
+  }
+  return out;
+}
+
 }  // namespace acvo

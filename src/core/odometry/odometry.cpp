@@ -271,6 +271,78 @@ Odometry::Registration Odometry::registerTo(const Tracked& reference,
 
 OdometryResult Odometry::process(const Frame& frame,
                                  const std::optional<Eigen::Isometry3d>& motion_guess) {
+  if (!colour_ratio_) {
+    OdometryResult r = track(frame, motion_guess);
+    checkColour(frame, r);
+    return r;
+  }
+  OdometryResult r = track(withColourResampled(frame, *colour_ratio_), motion_guess);
+  r.colour_resampled = true;
+  return r;
+}
+
+void Odometry::checkColour(const Frame& frame, OdometryResult& r) {
+  if (colour_check_.decided() || r.tracking == Tracking::kBadFrame ||
+      r.frame_index % ColourDepthCheck::kFrameStep != 0) {
+    return;
+  }
+  colour_check_.add(depthAsRegistered(frame, r));
+  if (!colour_check_.decided()) return;
+  r.colour_verdict_now = true;
+  actOnColourVerdict();
+  if (!colour_ratio_ || !last_ || last_->index != r.frame_index) return;
+  // This frame becomes the keyframe, its cloud built again from its colour resampled: the next
+  // frame, resampled, registered to a keyframe of colour as it came would pair each texture
+  // with where it was not (measured: 59 mm off on such a frame of a rendered room).
+  OdometryResult again;
+  const std::shared_ptr<PreparedCloud> cloud =
+      buildCloud(withColourResampled(frame, *colour_ratio_), again);
+  asReference(again, *cloud);
+  Tracked rebuilt = *last_;
+  rebuilt.cloud = cloud;
+  rebuilt.to_keyframe = Eigen::Isometry3d::Identity();
+  rebuilt.to_keyframe_covariance = Matrix6d::Zero();
+  keyframe_ = last_ = rebuilt;
+  r.new_keyframe = true;
+  r.ms_cloud += again.ms_cloud;
+  r.ms_prepare += again.ms_prepare;
+}
+
+void Odometry::actOnColourVerdict() {
+  const ColourDepthCheck::Verdict& v = colour_check_.verdict();
+  const bool had = colour_ratio_.has_value();
+  colour_ratio_.reset();
+  if (v.state == ColourDepthCheck::State::kUnregistered &&
+      params_.odometry.resample_unregistered_colour) {
+    colour_ratio_ = v.best_ratio;
+  }
+  if (had == colour_ratio_.has_value()) return;
+  // Resampled, a point's colour is still off by the cameras' baseline (a few pixels): near
+  // enough for the labels and the selection, too far for grey values compared at a sub-pixel
+  // (docs/accuracy.md, fourteenth round). The keyframe's prepared cloud serves either engine.
+  Params engine_params = params_;
+  if (colour_ratio_) engine_params.coarse_to_fine.photometric = false;
+  engine_ = makeRegistrationEngine(engine_params);
+}
+
+void Odometry::takeColourCheck(const ColourDepthCheck& check) {
+  colour_check_ = check;
+  actOnColourVerdict();
+}
+
+std::string Odometry::describeColour() const {
+  std::string text = colour_check_.describe();
+  if (colour_ratio_) {
+    text += ". Meanwhile each frame's colour is resampled by that ratio "
+            "(odometry/resample_unregistered_colour)";
+  }
+  return text;
+}
+
+void Odometry::newCamera() { takeColourCheck(ColourDepthCheck()); }
+
+OdometryResult Odometry::track(const Frame& frame,
+                               const std::optional<Eigen::Isometry3d>& motion_guess) {
   OdometryResult r;
   r.pose = pose_;
   r.pose_covariance = pose_covariance_;
@@ -281,6 +353,7 @@ OdometryResult Odometry::process(const Frame& frame,
     return r;
   }
   const std::shared_ptr<PreparedCloud> current = buildCloud(frame, r);
+  r.frame_index = frames_++;
   if (!keyframe_) {
     start(r, current);
     return r;
@@ -384,7 +457,6 @@ std::shared_ptr<PreparedCloud> Odometry::buildCloud(const Frame& frame, Odometry
   r.moving_points = current->size();
   r.ms_prepare = current->ms_prepare;
   r.cloud = std::shared_ptr<const LabelledCloud>(current, &current->cloud);
-  r.frame_index = frames_++;
   return current;
 }
 
