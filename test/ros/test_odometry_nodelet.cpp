@@ -1479,7 +1479,7 @@ TEST(OdometryNodelet, DepthNotRegisteredToTheColourIsNamed) {
   EXPECT_NE(warning->find("depth_registered"), std::string::npos) << *warning;
   const auto at = warning->find("focal length ");
   ASSERT_NE(at, std::string::npos) << *warning;
-  EXPECT_NEAR(std::stod(warning->substr(at + 13, 4)), 0.897, 0.03) << *warning;  // found: 0.91
+  EXPECT_NEAR(std::stod(warning->substr(at + 13, 4)), 0.897, 0.03) << *warning;
   EXPECT_NE(warning->find("resampled"), std::string::npos) << *warning;
   const std::string resampled = "unregistered (colour resampled to the depth camera)";
   EXPECT_EQ(judged(resampled), resampled);

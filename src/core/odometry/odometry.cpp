@@ -333,8 +333,8 @@ void Odometry::takeColourCheck(const ColourDepthCheck& check) {
 std::string Odometry::describeColour() const {
   std::string text = colour_check_.describe();
   if (colour_ratio_) {
-    text += ". Meanwhile each frame's colour is resampled by that ratio "
-            "(odometry/resample_unregistered_colour)";
+    text += ". Meanwhile each frame's colour is resampled by that ratio, and registered without "
+            "the photometric term (odometry/resample_unregistered_colour)";
   }
   return text;
 }
