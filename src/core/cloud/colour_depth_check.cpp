@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <vector>
 
 #include <opencv2/imgproc.hpp>
 
@@ -159,12 +160,18 @@ Frame withColourResampled(const Frame& frame, double ratio) {
   cv::warpAffine(frame.color, out.color, to_colour, frame.color.size(),
                  cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_REPLICATE);
   if (ratio > 1.0 && !frame.depth.empty()) {
+    // The colour image's reach is a rectangle: the columns and rows it covers, once each.
+    const cv::Mat& colour = frame.color;
+    std::vector<bool> seen_u(std::size_t(frame.depth.cols));
+    for (int u = 0; u < frame.depth.cols; ++u) {
+      seen_u[std::size_t(u)] = inside(colour, c.cx + ratio * (u - c.cx), 0.0);
+    }
     out.depth = frame.depth.clone();
     for (int v = 0; v < out.depth.rows; ++v) {
-      const double y = c.cy + ratio * (v - c.cy);
+      const bool seen_v = inside(colour, 0.0, c.cy + ratio * (v - c.cy));
       auto* d = out.depth.ptr<float>(v);
       for (int u = 0; u < out.depth.cols; ++u) {
-        if (!inside(frame.color, c.cx + ratio * (u - c.cx), y)) d[u] = 0.0f;
+        if (!seen_v || !seen_u[std::size_t(u)]) d[u] = 0.0f;
       }
     }
   }
