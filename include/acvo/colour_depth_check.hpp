@@ -13,12 +13,18 @@
 // enough frames with enough depth edges, a registered pair scores best at ratio 1 (TUM
 // fr3/teddy: 1.01, 1.04x the score at 1; every rendered sequence of docs/accuracy.md within
 // 0.01 of 1), an unregistered one away from it (7-Scenes' kitchen: 0.91, 1.6x; rendered at
-// 0.897: 0.88-0.90, 1.3-1.6x; at 1.1: 1.10, 1.27x). A baseline between the two cameras is not
-// searched: at 2.5 cm it moves the colour by 6 px at 2 m, the focal length up to 30 px, and a
-// two-parameter search mistook texture for silhouettes on rendered rooms. Colour and depth of two
-// instants (free-running streams) misalign by the motion between them: Odometry, which runs the
-// check, gives it the depth as it registered it (depthAsRegistered, odometry.hpp), and resamples
-// an unregistered camera's colour by the ratio found (withColourResampled, below).
+// 0.897: 0.88-0.90, 1.3-1.6x; at 1.1: 1.10, 1.27x). The verdict rests on that one-parameter
+// search alone. Once unregistered, the frames' evidence is searched again for the colour camera
+// itself: its focal ratio within 0.03 of the one found and its centre up to max_baseline along x
+// (a Kinect's two cameras are 2.5 cm apart), each edge pixel's point (its depth known) projected
+// into it: u' = cx + ratio (u - cx) - ratio fx baseline / z. With the depth, the baseline's
+// shift differs from silhouette to silhouette by their depths, which a texture does not mimic
+// (rendered rooms at 0.897 and 2.5 cm: found within 1 cm and 0.01; the ratio alone had come out
+// 0.85-0.96, the baseline biasing it; docs/accuracy.md, fifteenth round). Colour and depth of
+// two instants (free-running streams) misalign by the motion between them: Odometry, which runs
+// the check, gives it the depth as it registered it (depthAsRegistered, odometry.hpp), and
+// resamples an unregistered camera's colour by the ratio found, or by the camera found where
+// asked (withColourResampled, below; OdometryParams::resample_colour_baseline).
 #pragma once
 
 #include <array>
@@ -50,6 +56,8 @@ class ColourDepthCheck {
     double min_offset = 0.04;      // ... the best ratio this far from 1 ...
     double min_agreement = 0.6;    // ... and this fraction of the frames' own best within
     double agreement_within = 0.03;  // this of the best ratio
+    double max_baseline = 0.06;    // m: the colour camera's centre searched within this along x
+    int max_edges_per_frame = 1000;  // the camera search reads at most this many per frame
   };
 
   enum class State { kUndecided, kRegistered, kUnregistered };
@@ -57,6 +65,10 @@ class ColourDepthCheck {
   struct Verdict {
     State state = State::kUndecided;
     double best_ratio = 1.0;  // the colour focal length over the depth's that fits best
+    // The colour camera found once unregistered (findColourCamera): its focal ratio and its
+    // centre along x from the depth camera's, in m (best_ratio and 0 otherwise).
+    double camera_ratio = 1.0;
+    double baseline = 0.0;
     double gain = 1.0;        // the score at best_ratio over the score at ratio 1
     double agreement = 0.0;   // fraction of counted frames whose own best is within
                               // agreement_within of best_ratio
@@ -81,11 +93,32 @@ class ColourDepthCheck {
   static std::vector<std::array<int, 2>> depthEdges(const cv::Mat& depth, double depth_jump);
   static std::array<double, kRatios> scores(const cv::Mat& grey, const Camera& camera,
                                             const std::vector<std::array<int, 2>>& edges);
+  // The colour image's gradient magnitude, smoothed and normalised to mean 1 (empty for a blank
+  // image), and its mean at depth-edge points (u, v, z) as seen by a colour camera of focal
+  // ratio `ratio` whose centre is `baseline` m along x.
+  struct EdgePoint {
+    float u, v, z;
+  };
+  static cv::Mat edgeStrength(const cv::Mat& grey);
+  static double score(const cv::Mat& strength, const Camera& camera,
+                      const std::vector<EdgePoint>& edges, double ratio, double baseline);
 
  private:
+  static std::array<double, kRatios> ratioScores(const cv::Mat& strength, const Camera& camera,
+                                                 const std::vector<std::array<int, 2>>& edges);
   void decide();
+  // Searches the kept evidence for the colour camera (Verdict::camera_ratio, baseline).
+  void findColourCamera();
+
+  // A counted frame's evidence, kept until the verdict for the camera search.
+  struct Evidence {
+    cv::Mat strength;
+    std::vector<EdgePoint> edges;
+  };
 
   Options options_;
+  std::vector<Evidence> evidence_;
+  Camera camera_;
   std::array<double, kRatios> sum_{};
   std::vector<int> frame_best_;  // per counted frame, the index of its best ratio
   Verdict verdict_;
@@ -93,12 +126,13 @@ class ColourDepthCheck {
 
 std::string toString(ColourDepthCheck::State state);
 
-// The frame as a colour camera with the depth camera's focal length would have seen it, `ratio`
-// being the colour camera's focal length over the depth's (Verdict::best_ratio): the colour at
-// each pixel (u, v) taken from (cx + ratio (u - cx), cy + ratio (v - cy)) (bilinear), the depth
-// cleared where that falls outside the colour image (ratio > 1: no colour was seen there). The
-// baseline between the two cameras is not modelled (see above): a point's colour stays off by
-// baseline x focal / depth, a few pixels, which is the same at every pixel of one depth.
-Frame withColourResampled(const Frame& frame, double ratio);
+// The frame as a colour camera in the depth camera's place would have seen it, `ratio` being the
+// colour camera's focal length over the depth's and `baseline` its centre along x in metres
+// (Verdict::best_ratio, or Verdict::camera_ratio and baseline): the colour at each pixel (u, v)
+// with depth z taken from (cx + ratio (u - cx) - ratio fx baseline / z, cy + ratio (v - cy)) (bilinear; a pixel
+// without depth as if at the frame's median depth), the depth cleared where that falls outside
+// the colour image (no colour was seen there). A point hidden from the colour camera by a nearer
+// one takes the nearer one's colour, as on any registered camera.
+Frame withColourResampled(const Frame& frame, double ratio, double baseline = 0.0);
 
 }  // namespace acvo

@@ -51,30 +51,56 @@ std::vector<std::array<int, 2>> ColourDepthCheck::depthEdges(const cv::Mat& dept
   return edges;
 }
 
-std::array<double, ColourDepthCheck::kRatios> ColourDepthCheck::scores(
-    const cv::Mat& grey, const Camera& camera, const std::vector<std::array<int, 2>>& edges) {
-  std::array<double, kRatios> out{};
-  if (edges.empty() || grey.cols < 2 || grey.rows < 2) return out;
+cv::Mat ColourDepthCheck::edgeStrength(const cv::Mat& grey) {
+  if (grey.cols < 2 || grey.rows < 2) return {};
   cv::Mat gx, gy, magnitude;
   cv::Sobel(grey, gx, CV_32F, 1, 0, 3);
   cv::Sobel(grey, gy, CV_32F, 0, 1, 3);
   cv::magnitude(gx, gy, magnitude);
   cv::GaussianBlur(magnitude, magnitude, cv::Size(), 1.0);
   const double mean = cv::mean(magnitude)[0];
-  if (!(mean > 0.0)) return out;  // a blank image: no colour edges anywhere
+  if (!(mean > 0.0)) return {};  // a blank image: no colour edges anywhere
+  magnitude *= 1.0 / mean;
+  return magnitude;
+}
+
+std::array<double, ColourDepthCheck::kRatios> ColourDepthCheck::scores(
+    const cv::Mat& grey, const Camera& camera, const std::vector<std::array<int, 2>>& edges) {
+  return ratioScores(edgeStrength(grey), camera, edges);
+}
+
+std::array<double, ColourDepthCheck::kRatios> ColourDepthCheck::ratioScores(
+    const cv::Mat& strength, const Camera& camera, const std::vector<std::array<int, 2>>& edges) {
+  std::array<double, kRatios> out{};
+  if (edges.empty() || strength.empty()) return out;
   for (int i = 0; i < kRatios; ++i) {
     const double ratio = ratioAt(i);
     double sum = 0.0;
     int n = 0;
     for (const auto& [u, v] : edges) {
       const double x = camera.cx + ratio * (u - camera.cx), y = camera.cy + ratio * (v - camera.cy);
-      if (!inside(magnitude, x, y)) continue;  // a narrower colour camera does not see it
-      sum += sample(magnitude, x, y);
+      if (!inside(strength, x, y)) continue;  // a narrower colour camera does not see it
+      sum += sample(strength, x, y);
       ++n;
     }
-    out[std::size_t(i)] = n > 0 ? sum / (mean * double(n)) : 0.0;
+    out[std::size_t(i)] = n > 0 ? sum / double(n) : 0.0;
   }
   return out;
+}
+
+double ColourDepthCheck::score(const cv::Mat& strength, const Camera& camera,
+                               const std::vector<EdgePoint>& edges, double ratio, double baseline) {
+  const double shift = ratio * camera.fx * baseline;
+  double sum = 0.0;
+  int n = 0;
+  for (const EdgePoint& e : edges) {
+    const double x = camera.cx + ratio * (e.u - camera.cx) - shift / e.z;
+    const double y = camera.cy + ratio * (e.v - camera.cy);
+    if (!inside(strength, x, y)) continue;
+    sum += sample(strength, x, y);
+    ++n;
+  }
+  return n > 0 ? sum / double(n) : 0.0;
 }
 
 const ColourDepthCheck::Verdict& ColourDepthCheck::add(const Frame& frame) {
@@ -82,19 +108,36 @@ const ColourDepthCheck::Verdict& ColourDepthCheck::add(const Frame& frame) {
   ++verdict_.frames_seen;
   const auto edges = depthEdges(frame.depth, options_.depth_jump);
   if (int(edges.size()) < options_.min_edge_pixels) return verdict_;
-  const auto s = scores(grayImage(frame), frame.camera, edges);
+  Evidence evidence;
+  evidence.strength = edgeStrength(grayImage(frame));
+  const auto s = ratioScores(evidence.strength, frame.camera, edges);
   if (s[kRatios / 2] <= 0.0) return verdict_;  // no colour edges (a blank colour image)
   for (int i = 0; i < kRatios; ++i) sum_[std::size_t(i)] += s[std::size_t(i)];
   frame_best_.push_back(int(std::max_element(s.begin(), s.end()) - s.begin()));
   ++verdict_.frames;
-  if (verdict_.frames >= options_.frames_needed) decide();
+  // The evidence for the camera search: the edge strength and, evenly thinned, the edges with
+  // their depth.
+  const std::size_t step = std::max<std::size_t>(
+      1, edges.size() / std::size_t(std::max(1, options_.max_edges_per_frame)));
+  for (std::size_t i = 0; i < edges.size(); i += step) {
+    const auto [u, v] = edges[i];
+    evidence.edges.push_back({float(u), float(v), frame.depth.at<float>(v, u)});
+  }
+  evidence_.push_back(std::move(evidence));
+  camera_ = frame.camera;
+  if (verdict_.frames >= options_.frames_needed) {
+    decide();
+    if (verdict_.state == State::kUnregistered) findColourCamera();
+    evidence_.clear();
+    evidence_.shrink_to_fit();
+  }
   return verdict_;
 }
 
 void ColourDepthCheck::decide() {
   const int best = int(std::max_element(sum_.begin(), sum_.end()) - sum_.begin());
   const int one = kRatios / 2;  // ratio 1.00
-  verdict_.best_ratio = ratioAt(best);
+  verdict_.best_ratio = verdict_.camera_ratio = ratioAt(best);
   verdict_.gain = sum_[std::size_t(best)] / sum_[std::size_t(one)];
   // Options in ratios, as whole steps of the ratio grid.
   auto steps = [](double ratio) { return int(std::lround(ratio / kRatioStep)); };
@@ -106,6 +149,37 @@ void ColourDepthCheck::decide() {
                             verdict_.gain >= options_.min_gain &&
                             verdict_.agreement >= options_.min_agreement;
   verdict_.state = unregistered ? State::kUnregistered : State::kRegistered;
+}
+
+void ColourDepthCheck::findColourCamera() {
+  // The frames' mean score of one colour camera; frames count alike, as in the ratio search.
+  auto total = [&](double ratio, double baseline) {
+    double sum = 0.0;
+    for (const Evidence& e : evidence_) sum += score(e.strength, camera_, e.edges, ratio, baseline);
+    return sum;
+  };
+  // A grid (focal ratio within 0.03 of the one found, by 0.005; baseline by 5 mm), then a finer
+  // one about its best (by 0.001 and 1 mm): about 400 cameras in all.
+  auto search = [&](double ratio0, double ratio_reach, double ratio_step, double baseline0,
+                    double baseline_reach, double baseline_step) {
+    double best = -1.0;
+    const int nr = int(std::lround(ratio_reach / ratio_step));
+    const int nb = int(std::lround(baseline_reach / baseline_step));
+    for (int i = -nr; i <= nr; ++i) {
+      for (int j = -nb; j <= nb; ++j) {
+        const double ratio = ratio0 + i * ratio_step, baseline = baseline0 + j * baseline_step;
+        if (std::abs(baseline) > options_.max_baseline + 1e-9) continue;
+        const double s = total(ratio, baseline);
+        if (s > best) {
+          best = s;
+          verdict_.camera_ratio = ratio;
+          verdict_.baseline = baseline;
+        }
+      }
+    }
+  };
+  search(verdict_.best_ratio, 0.03, 0.005, 0.0, options_.max_baseline, 0.005);
+  search(verdict_.camera_ratio, 0.004, 0.001, verdict_.baseline, 0.004, 0.001);
 }
 
 std::string ColourDepthCheck::describe() const {
@@ -127,11 +201,12 @@ std::string ColourDepthCheck::describe() const {
       std::snprintf(text, sizeof text,
                     "the depth image does not look registered to the colour image: the colour "
                     "edges fit the depth edges best with the colour focal length %.2f times the "
-                    "depth's (%.1fx the score as given, %d frames). acvo needs depth registered "
+                    "depth's (%.1fx the score as given, %d frames; as a camera beside the depth "
+                    "camera: %.3f times, its centre %.1f cm along x). acvo needs depth registered "
                     "pixel for pixel to the colour camera: use the driver's depth_registered "
                     "image (openni2_launch depth_registration:=true, realsense2_camera "
                     "align_depth:=true) or depth_image_proc/register",
-                    v.best_ratio, v.gain, v.frames);
+                    v.best_ratio, v.gain, v.frames, v.camera_ratio, 100.0 * v.baseline);
       break;
   }
   return text;
@@ -149,32 +224,73 @@ std::string toString(ColourDepthCheck::State state) {
   return "undecided";
 }
 
-Frame withColourResampled(const Frame& frame, double ratio) {
-  if (frame.color.empty() || ratio == 1.0 || !(ratio > 0.0)) return frame;
-  const Camera& c = frame.camera;
-  // Scaling about the principal point: cv::warpAffine with the map from each output pixel to
-  // where it is read.
-  const cv::Matx23d to_colour(ratio, 0.0, c.cx * (1.0 - ratio), 0.0, ratio, c.cy * (1.0 - ratio));
-  Frame out = frame;
-  out.color = cv::Mat();  // a new image: the frame's own is shared, not written
-  cv::warpAffine(frame.color, out.color, to_colour, frame.color.size(),
-                 cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_REPLICATE);
-  if (ratio > 1.0 && !frame.depth.empty()) {
-    // The colour image's reach is a rectangle: the columns and rows it covers, once each.
-    const cv::Mat& colour = frame.color;
-    std::vector<bool> seen_u(std::size_t(frame.depth.cols));
-    for (int u = 0; u < frame.depth.cols; ++u) {
-      seen_u[std::size_t(u)] = inside(colour, c.cx + ratio * (u - c.cx), 0.0);
-    }
-    out.depth = frame.depth.clone();
-    for (int v = 0; v < out.depth.rows; ++v) {
-      const bool seen_v = inside(colour, 0.0, c.cy + ratio * (v - c.cy));
-      auto* d = out.depth.ptr<float>(v);
-      for (int u = 0; u < out.depth.cols; ++u) {
-        if (!seen_v || !seen_u[std::size_t(u)]) d[u] = 0.0f;
-      }
+namespace {
+
+// The median of the frame's valid depth, from every 4th pixel of every 4th row (0 if none).
+double medianDepth(const cv::Mat& depth) {
+  std::vector<float> values;
+  for (int v = 0; v < depth.rows; v += 4) {
+    const float* d = depth.ptr<float>(v);
+    for (int u = 0; u < depth.cols; u += 4) {
+      if (d[u] > 0.0f && std::isfinite(d[u])) values.push_back(d[u]);
     }
   }
+  if (values.empty()) return 0.0;
+  auto middle = values.begin() + std::ptrdiff_t(values.size() / 2);
+  std::nth_element(values.begin(), middle, values.end());
+  return *middle;
+}
+
+}  // namespace
+
+Frame withColourResampled(const Frame& frame, double ratio, double baseline) {
+  if (frame.color.empty() || !(ratio > 0.0) || (ratio == 1.0 && baseline == 0.0)) return frame;
+  const Camera& c = frame.camera;
+  Frame out = frame;
+  out.color = cv::Mat();  // a new image: the frame's own is shared, not written
+  const cv::Mat& colour = frame.color;
+  const double fill_depth = baseline != 0.0 ? medianDepth(frame.depth) : 0.0;
+  if (baseline == 0.0 || !(fill_depth > 0.0)) {
+    // Scaling about the principal point: cv::warpAffine with the map from each output pixel to
+    // where it is read.
+    const cv::Matx23d to_colour(ratio, 0.0, c.cx * (1.0 - ratio), 0.0, ratio, c.cy * (1.0 - ratio));
+    cv::warpAffine(colour, out.color, to_colour, colour.size(),
+                   cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_REPLICATE);
+    if (ratio > 1.0 && !frame.depth.empty()) {
+      // The colour image's reach is a rectangle: the columns and rows it covers, once each.
+      std::vector<bool> seen_u(std::size_t(frame.depth.cols));
+      for (int u = 0; u < frame.depth.cols; ++u) {
+        seen_u[std::size_t(u)] = inside(colour, c.cx + ratio * (u - c.cx), 0.0);
+      }
+      out.depth = frame.depth.clone();
+      for (int v = 0; v < out.depth.rows; ++v) {
+        const bool seen_v = inside(colour, 0.0, c.cy + ratio * (v - c.cy));
+        auto* d = out.depth.ptr<float>(v);
+        for (int u = 0; u < out.depth.cols; ++u) {
+          if (!seen_v || !seen_u[std::size_t(u)]) d[u] = 0.0f;
+        }
+      }
+    }
+    return out;
+  }
+  // With a baseline each pixel's source depends on its depth: a map per pixel for cv::remap.
+  const double shift = ratio * c.fx * baseline;
+  cv::Mat map_u(frame.depth.size(), CV_32FC1), map_v(frame.depth.size(), CV_32FC1);
+  out.depth = frame.depth.clone();
+  for (int v = 0; v < out.depth.rows; ++v) {
+    float* d = out.depth.ptr<float>(v);
+    float* mu = map_u.ptr<float>(v);
+    float* mv = map_v.ptr<float>(v);
+    const double y = c.cy + ratio * (v - c.cy);
+    for (int u = 0; u < out.depth.cols; ++u) {
+      const bool has_depth = d[u] > 0.0f && std::isfinite(d[u]);
+      const double x = c.cx + ratio * (u - c.cx) - shift / (has_depth ? d[u] : fill_depth);
+      mu[u] = float(x);
+      mv[u] = float(y);
+      if (has_depth && !inside(colour, x, y)) d[u] = 0.0f;  // the colour camera saw nothing
+    }
+  }
+  cv::remap(colour, out.color, map_u, map_v, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
   return out;
 }
 

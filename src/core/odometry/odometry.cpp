@@ -276,7 +276,7 @@ OdometryResult Odometry::process(const Frame& frame,
     checkColour(frame, r);
     return r;
   }
-  OdometryResult r = track(withColourResampled(frame, *colour_ratio_), motion_guess);
+  OdometryResult r = track(resampled(frame), motion_guess);
   r.colour_resampled = true;
   return r;
 }
@@ -296,7 +296,7 @@ void Odometry::checkColour(const Frame& frame, OdometryResult& r) {
   // with where it was not (measured: 59 mm off on such a frame of a rendered room).
   OdometryResult again;
   const std::shared_ptr<PreparedCloud> cloud =
-      buildCloud(withColourResampled(frame, *colour_ratio_), again);
+      buildCloud(resampled(frame), again);
   asReference(again, *cloud);
   Tracked rebuilt = *last_;
   rebuilt.cloud = cloud;
@@ -308,18 +308,26 @@ void Odometry::checkColour(const Frame& frame, OdometryResult& r) {
   r.ms_prepare += again.ms_prepare;
 }
 
+Frame Odometry::resampled(const Frame& frame) const {
+  const double baseline =
+      params_.odometry.resample_colour_baseline ? colour_check_.verdict().baseline : 0.0;
+  return withColourResampled(frame, *colour_ratio_, baseline);
+}
+
 void Odometry::actOnColourVerdict() {
   const ColourDepthCheck::Verdict& v = colour_check_.verdict();
   const bool had = colour_ratio_.has_value();
   colour_ratio_.reset();
   if (v.state == ColourDepthCheck::State::kUnregistered &&
       params_.odometry.resample_unregistered_colour) {
-    colour_ratio_ = v.best_ratio;
+    colour_ratio_ = params_.odometry.resample_colour_baseline ? v.camera_ratio : v.best_ratio;
   }
   if (had == colour_ratio_.has_value()) return;
-  // Resampled, a point's colour is still off by the cameras' baseline (a few pixels): near
-  // enough for the labels and the selection, too far for grey values compared at a sub-pixel
-  // (docs/accuracy.md, fourteenth round). The keyframe's prepared cloud serves either engine.
+  // Resampled by the focal ratio, a point's colour is still off by the cameras' baseline (a few
+  // pixels), and by the baseline found too, by that estimate's error (about 5 mm, a pixel or two
+  // at 2 m): near enough for the labels and the selection, too far for grey values compared at
+  // a sub-pixel (docs/accuracy.md, fourteenth and fifteenth rounds). The keyframe's prepared
+  // cloud serves either engine.
   Params engine_params = params_;
   if (colour_ratio_) engine_params.coarse_to_fine.photometric = false;
   engine_ = makeRegistrationEngine(engine_params);
@@ -333,8 +341,12 @@ void Odometry::takeColourCheck(const ColourDepthCheck& check) {
 std::string Odometry::describeColour() const {
   std::string text = colour_check_.describe();
   if (colour_ratio_) {
-    text += ". Meanwhile each frame's colour is resampled by that ratio, and registered without "
-            "the photometric term (odometry/resample_unregistered_colour)";
+    text += params_.odometry.resample_colour_baseline
+                ? ". Meanwhile each frame's colour is resampled to the depth camera by that "
+                  "camera, and registered without the photometric term "
+                  "(odometry/resample_unregistered_colour, resample_colour_baseline)"
+                : ". Meanwhile each frame's colour is resampled by that ratio, and registered "
+                  "without the photometric term (odometry/resample_unregistered_colour)";
   }
   return text;
 }
