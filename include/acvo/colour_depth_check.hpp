@@ -104,8 +104,9 @@ class ColourDepthCheck {
                       const std::vector<EdgePoint>& edges, double ratio, double baseline);
 
  private:
+  // score() at every ratio of the grid, without a baseline.
   static std::array<double, kRatios> ratioScores(const cv::Mat& strength, const Camera& camera,
-                                                 const std::vector<std::array<int, 2>>& edges);
+                                                 const std::vector<EdgePoint>& edges);
   void decide();
   // Searches the kept evidence for the colour camera (Verdict::camera_ratio, baseline).
   void findColourCamera();
@@ -129,9 +130,9 @@ std::string toString(ColourDepthCheck::State state);
 // The frame as a colour camera in the depth camera's place would have seen it, `ratio` being the
 // colour camera's focal length over the depth's and `baseline` its centre along x in metres
 // (Verdict::best_ratio, or Verdict::camera_ratio and baseline): the colour at each pixel (u, v)
-// with depth z taken from (cx + ratio (u - cx) - ratio fx baseline / z, cy + ratio (v - cy)) (bilinear; a pixel
-// without depth as if at the frame's median depth), the depth cleared where that falls outside
-// the colour image (no colour was seen there). A point hidden from the colour camera by a nearer
+// with depth z taken from (cx + ratio (u - cx) - ratio fx baseline / z, cy + ratio (v - cy))
+// (bilinear; a pixel without depth as if at the frame's median depth), the depth cleared where
+// that falls outside the colour image (no colour was seen there). A point hidden from the colour camera by a nearer
 // one takes the nearer one's colour, as on any registered camera.
 Frame withColourResampled(const Frame& frame, double ratio, double baseline = 0.0);
 

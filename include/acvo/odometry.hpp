@@ -171,8 +171,8 @@ class Odometry {
   // Whether depth and colour look registered, from every ColourDepthCheck::kFrameStep-th frame
   // (as registered: depthAsRegistered) until it decides; and the focal ratio each frame's
   // colour is resampled by since (an unregistered verdict, resample_unregistered_colour), if
-  // any, with the baseline colourCheck().verdict().baseline. Neither changes with reset(): they
-  // concern the camera.
+  // any (with resample_colour_baseline, the camera's ratio, and its baseline
+  // colourCheck().verdict().baseline). Neither changes with reset(): they concern the camera.
   const ColourDepthCheck& colourCheck() const { return colour_check_; }
   std::optional<double> colourResampling() const { return colour_ratio_; }
   // The check's verdict for a log (ColourDepthCheck::describe), and what is done about it.
@@ -200,10 +200,10 @@ class Odometry {
   // unregistered, resamples it from then on (actOnColourVerdict) and makes this frame the
   // keyframe, its cloud rebuilt from its resampled colour.
   void checkColour(const Frame& frame, OdometryResult& r);
-  // The colour resampling for the check's verdict (resample_unregistered_colour), and the
-  // engine without the photometric term while it lasts.
   // The frame with its colour resampled to the depth camera (colour_ratio_ set).
   Frame resampled(const Frame& frame) const;
+  // The colour resampling for the check's verdict (resample_unregistered_colour), and the
+  // engine without the photometric term while it lasts.
   void actOnColourVerdict();
   // The steps of track(), in order.
   // The camera's motion over `seconds`, as the last frame-to-frame motion says; none until two
@@ -253,7 +253,8 @@ class Odometry {
   int lost_in_a_row_ = 0;
   std::uint64_t frames_ = 0;  // frames numbered so far
   ColourDepthCheck colour_check_;
-  // Each frame's colour is resampled by it and the verdict's baseline (colourResampling).
+  // Each frame's colour is resampled by it (colourResampling), and by the verdict's baseline with
+  // resample_colour_baseline (resampled()).
   std::optional<double> colour_ratio_;
   struct Arena;               // the thread pool the solver runs in (odometry.threads)
   std::unique_ptr<Arena> arena_;

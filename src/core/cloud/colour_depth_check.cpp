@@ -66,24 +66,19 @@ cv::Mat ColourDepthCheck::edgeStrength(const cv::Mat& grey) {
 
 std::array<double, ColourDepthCheck::kRatios> ColourDepthCheck::scores(
     const cv::Mat& grey, const Camera& camera, const std::vector<std::array<int, 2>>& edges) {
-  return ratioScores(edgeStrength(grey), camera, edges);
+  std::vector<EdgePoint> points;
+  points.reserve(edges.size());
+  for (const auto& [u, v] : edges) points.push_back({float(u), float(v), 1.0f});  // z: no baseline
+  return ratioScores(edgeStrength(grey), camera, points);
 }
 
 std::array<double, ColourDepthCheck::kRatios> ColourDepthCheck::ratioScores(
-    const cv::Mat& strength, const Camera& camera, const std::vector<std::array<int, 2>>& edges) {
+    const cv::Mat& strength, const Camera& camera, const std::vector<EdgePoint>& edges) {
   std::array<double, kRatios> out{};
   if (edges.empty() || strength.empty()) return out;
+  // A narrower colour camera does not see every edge: score() counts the ones it sees.
   for (int i = 0; i < kRatios; ++i) {
-    const double ratio = ratioAt(i);
-    double sum = 0.0;
-    int n = 0;
-    for (const auto& [u, v] : edges) {
-      const double x = camera.cx + ratio * (u - camera.cx), y = camera.cy + ratio * (v - camera.cy);
-      if (!inside(strength, x, y)) continue;  // a narrower colour camera does not see it
-      sum += sample(strength, x, y);
-      ++n;
-    }
-    out[std::size_t(i)] = n > 0 ? sum / double(n) : 0.0;
+    out[std::size_t(i)] = score(strength, camera, edges, ratioAt(i), 0.0);
   }
   return out;
 }
@@ -106,8 +101,13 @@ double ColourDepthCheck::score(const cv::Mat& strength, const Camera& camera,
 const ColourDepthCheck::Verdict& ColourDepthCheck::add(const Frame& frame) {
   if (decided() || !frame.problem().empty()) return verdict_;
   ++verdict_.frames_seen;
-  const auto edges = depthEdges(frame.depth, options_.depth_jump);
-  if (int(edges.size()) < options_.min_edge_pixels) return verdict_;
+  const auto pixels = depthEdges(frame.depth, options_.depth_jump);
+  if (int(pixels.size()) < options_.min_edge_pixels) return verdict_;
+  std::vector<EdgePoint> edges;
+  edges.reserve(pixels.size());
+  for (const auto& [u, v] : pixels) {
+    edges.push_back({float(u), float(v), frame.depth.at<float>(v, u)});
+  }
   Evidence evidence;
   evidence.strength = edgeStrength(grayImage(frame));
   const auto s = ratioScores(evidence.strength, frame.camera, edges);
@@ -115,14 +115,10 @@ const ColourDepthCheck::Verdict& ColourDepthCheck::add(const Frame& frame) {
   for (int i = 0; i < kRatios; ++i) sum_[std::size_t(i)] += s[std::size_t(i)];
   frame_best_.push_back(int(std::max_element(s.begin(), s.end()) - s.begin()));
   ++verdict_.frames;
-  // The evidence for the camera search: the edge strength and, evenly thinned, the edges with
-  // their depth.
+  // The evidence for the camera search: the edge strength and the edges, evenly thinned.
   const std::size_t step = std::max<std::size_t>(
       1, edges.size() / std::size_t(std::max(1, options_.max_edges_per_frame)));
-  for (std::size_t i = 0; i < edges.size(); i += step) {
-    const auto [u, v] = edges[i];
-    evidence.edges.push_back({float(u), float(v), frame.depth.at<float>(v, u)});
-  }
+  for (std::size_t i = 0; i < edges.size(); i += step) evidence.edges.push_back(edges[i]);
   evidence_.push_back(std::move(evidence));
   camera_ = frame.camera;
   if (verdict_.frames >= options_.frames_needed) {
