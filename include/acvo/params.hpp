@@ -176,7 +176,7 @@ struct OdometryParams {
   // centre along x, the colour at depth z shifted by ratio fx baseline / z) instead of the focal
   // ratio alone. Off by default: on five rendered rooms with 7-Scenes' two cameras it registers
   // the colour better (u32 0.0116 -> 0.0036 m/s, the others 1.0-1.4x), on the real 7-Scenes
-  // kitchen it measured worse (0.0321 -> 0.0380 m/s; every 2nd frame 0.0301 -> 0.0348), whose
+  // kitchen it measured worse (0.0321 -> 0.0380 m/s; every 2nd frame 0.0301 -> 0.0347), whose
   // colour and depth come from free-running streams through real lenses (docs/accuracy.md,
   // fifteenth round). On: for two synchronised cameras known to be pinholes (a simulator's).
   bool resample_colour_baseline = false;

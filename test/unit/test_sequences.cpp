@@ -586,7 +586,7 @@ TEST(Sequences, ColourFromASecondCameraIsResampledToTheDepthCamera) {
               runs[0].rpe.trans.rmse, runs[0].rpe.rot_deg.rmse, runs[1].rpe.trans.rmse,
               runs[1].rpe.rot_deg.rmse, runs[2].rpe.trans.rmse, runs[2].rpe.rot_deg.rmse);
   for (const auto& run : runs) EXPECT_EQ(run.lost, 0);
-  // Measured 0.00626 m/s, 0.2320 deg/s resampled, 0.02326, 0.5199 as it came, 0.00543, 0.2162
+  // Measured 0.00626 m/s, 0.2320 deg/s resampled, 0.02326, 0.5199 as it came, 0.00532, 0.2324
   // with the baseline (150 frames, acvo_compare: 0.0069 / 0.211, 0.0232 / 0.528, 0.0061 /
   // 0.203; with the colour registered before the first frame, 0.0047 / 0.036: most of the
   // rotation error is the first ten frames').
@@ -594,9 +594,9 @@ TEST(Sequences, ColourFromASecondCameraIsResampledToTheDepthCamera) {
   EXPECT_LT(runs[0].rpe.rot_deg.rmse, 1.3 * 0.2320);
   EXPECT_GT(runs[1].rpe.trans.rmse, 3.0 * runs[0].rpe.trans.rmse);
   EXPECT_GT(runs[1].rpe.rot_deg.rmse, 1.8 * runs[0].rpe.rot_deg.rmse);
-  EXPECT_LT(runs[2].rpe.trans.rmse, 1.3 * 0.00543);
-  EXPECT_LT(runs[2].rpe.rot_deg.rmse, 1.3 * 0.2162);
-  EXPECT_LT(runs[2].rpe.trans.rmse, 0.95 * runs[0].rpe.trans.rmse);  // measured 0.87
+  EXPECT_LT(runs[2].rpe.trans.rmse, 1.3 * 0.00532);
+  EXPECT_LT(runs[2].rpe.rot_deg.rmse, 0.281);  // 1.21x the measured
+  EXPECT_LT(runs[2].rpe.trans.rmse, 0.95 * runs[0].rpe.trans.rmse);  // measured 0.85
 }
 
 // A lens's vignetting: the colour darkens by exp(-1 rho) towards the corners (43% at a corner),
