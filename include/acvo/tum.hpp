@@ -1,11 +1,13 @@
 // TUM RGB-D benchmark formats: image lists, rgb/depth association, trajectories, datasets.
 #pragma once
 
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include <Eigen/Geometry>
+#include <opencv2/core.hpp>
 
 #include "acvo/camera.hpp"
 #include "acvo/frame.hpp"
@@ -54,6 +56,20 @@ Trajectory readTrajectory(const std::string& path);
 void writeTrajectory(const std::string& path, const Trajectory& trajectory,
                      const std::string& header_comment = "");
 
+// A lens's radial-tangential distortion in OpenCV's order (ROS's plumb_bob): k1 k2 p1 p2 k3.
+struct LensDistortion {
+  std::array<double, 5> coefficients{};
+  bool any() const;
+};
+
+// The distortion of a camera yaml file: keys k1 k2 p1 p2 k3, or d0 d1 d2 d3 d4 (TUM's names),
+// or distortion_coefficients as a list or as OpenCV's/ROS's {data: [...]}; absent keys are 0.
+// Throws std::runtime_error naming the file and key when a value is not a number.
+LensDistortion loadDistortionYaml(const std::string& path);
+// TUM's published distortion of its raw fr1 and fr2 colour images; zero for fr3 (its images
+// were undistorted before publication) and default.
+LensDistortion distortionByName(const std::string& name);
+
 // A TUM-format dataset folder: rgb.txt, depth.txt, optional associations.txt,
 // optional groundtruth.txt, optional camera.yaml.
 class TumDataset {
@@ -68,14 +84,24 @@ class TumDataset {
   std::size_t size() const { return frames_.size(); }
   const std::optional<Trajectory>& groundtruth() const { return groundtruth_; }
 
+  // The camera's lens distortion: where the camera file or name gives one, every frame is
+  // undistorted on loading (below), and camera() describes the undistorted images.
+  const LensDistortion& distortion() const { return distortion_; }
+
   // Loads frame i: colour as BGR (OpenCV's order, marked in Frame::order), depth converted to
-  // metres with the camera's depth scale. Throws std::runtime_error naming the file when an
-  // image does not load, has the wrong type, or its size differs from the camera's.
+  // metres with the camera's depth scale. With a lens distortion, both images are undistorted
+  // to the same pinhole camera (the depth is registered to the colour pixel for pixel): the
+  // colour bilinearly, the depth from its nearest pixel (no depth mixed across an edge), pixels
+  // seen by no raw pixel without depth (their colour the nearest raw pixel's). Throws
+  // std::runtime_error naming the file when an image does not load, has the wrong type, or its size
+  // differs from the camera's.
   Frame loadFrame(std::size_t i) const;
 
  private:
   std::string folder_;
   Camera camera_;
+  LensDistortion distortion_;
+  cv::Mat undistort_x_, undistort_y_;  // raw pixel of each undistorted pixel; empty: none
   std::vector<TumAssociation> frames_;
   std::optional<Trajectory> groundtruth_;
 };

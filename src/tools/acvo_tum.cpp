@@ -51,7 +51,8 @@ std::optional<int> parseOptions(CLI::App& app, Options& o, int argc, char** argv
   app.add_option("--config", o.config, "parameters (YAML; default: the built-in defaults)")
       ->type_name("FILE");
   app.add_option("--camera", o.camera,
-                 "intrinsics (default: DATASET_DIR/camera.yaml, else default)")
+                 "intrinsics, and a lens distortion the frames are undistorted by (default: "
+                 "DATASET_DIR/camera.yaml, else default)")
       ->type_name("FILE|fr1|fr2|fr3|default");
   app.add_option("--output", o.output, "the trajectory (default DATASET_DIR/acvo_trajectory.txt)")
       ->type_name("TRAJ");
@@ -87,6 +88,12 @@ int main(int argc, char** argv) {
     }
     if (opt.threads >= 0) params.odometry.threads = opt.threads;
     const acvo::TumDataset data(opt.dataset, opt.camera);
+    if (data.distortion().any()) {
+      const auto& k = data.distortion().coefficients;
+      std::cerr << "acvo_tum: the camera's lens distortion (k1 k2 p1 p2 k3 = " << k[0] << ' '
+                << k[1] << ' ' << k[2] << ' ' << k[3] << ' ' << k[4]
+                << "): every frame undistorted on loading\n";
+    }
     const std::string output =
         opt.output.empty() ? opt.dataset + "/acvo_trajectory.txt" : opt.output;
     const long first = std::min<long>(opt.start, long(data.size()));
@@ -164,8 +171,8 @@ int main(int argc, char** argv) {
               << ',' << ms << ',' << acvo::tools::residentKiB() << ',' << r.keyframe_index << ','
               << int(r.new_keyframe) << ',' << 1e3 * r.depth_delay << ','
               << (r.depth_retimed ? 2 : int(r.depth_synced)) << ',' << r.own_velocity_weight[0]
-              << ',' << r.own_velocity_weight[1] << ',' << s.brightness_gain << ','
-              << s.vignetting << ',' << s.dense_weight << '\n';
+              << ',' << r.own_velocity_weight[1] << ',' << s.brightness_gain << ',' << s.vignetting
+              << ',' << s.dense_weight << '\n';
       }
       if (progress) {
         std::fprintf(stderr, "\racvo_tum: frame %ld/%ld  %3d it  %6.1f ms  %s    ", k - first + 1,

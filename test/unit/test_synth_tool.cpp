@@ -1,10 +1,12 @@
 // acvo_synth end to end: a tiny sequence on disk, its lists, groundtruth and camera file,
-// determinism, an unregistered colour camera (and scripts/register_colour undoing it), colour
+// determinism, an unregistered colour camera (and scripts/register_colour undoing it), a lens
+// (scripts/distort_tum, undone on loading), scripts/downsample_tum, colour
 // taken after the depth, a swinging brightness, vignetting, and the errors for bad options.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -15,6 +17,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "acvo/camera.hpp"
+#include "acvo/tum.hpp"
 #include "synth/layout.hpp"
 #include "synth/sequence.hpp"
 #include "test_support.hpp"
@@ -184,7 +187,7 @@ TEST(SynthTool, ColourTakenLaterIsRenderedAndStampedAtItsOwnTime) {
     EXPECT_EQ(readBytes(a / "depth" / (depth_stamp + ".png")),
               readBytes(b / "depth" / (depth_stamp + ".png")));
     EXPECT_TRUE(fs::exists(b / "rgb" / (colour_stamp + ".png")));
-    EXPECT_EQ(gt_b[2 * i], gt_a[i]);           // the depth's pose, as without the delay
+    EXPECT_EQ(gt_b[2 * i], gt_a[i]);              // the depth's pose, as without the delay
     EXPECT_EQ(gt_b[2 * i + 1][0], colour_stamp);  // then the colour's
     EXPECT_NE(gt_b[2 * i + 1], gt_a[i]);
   }
@@ -200,20 +203,19 @@ TEST(SynthTool, ColourTakenLaterIsRenderedAndStampedAtItsOwnTime) {
   EXPECT_DOUBLE_EQ(f.stamp, seq.stamp(1) - 0.01);
   EXPECT_EQ(f.toFrame().depth_stamp, f.depth_stamp);
   EXPECT_TRUE(seq.colourPose(1).isApprox(seq.motion().poseAt(1.0 / 30.0 - 0.01)));
-  EXPECT_EQ(cv::norm(f.bgr, render(seq.scene(), seq.colourPose(1), o.renderOptions()).bgr,
-                     cv::NORM_INF),
-            0.0);
-  EXPECT_GT(cv::norm(f.bgr, render(seq.scene(), seq.poses()[1], o.renderOptions()).bgr,
-                     cv::NORM_INF),
-            0.0);
+  EXPECT_EQ(
+      cv::norm(f.bgr, render(seq.scene(), seq.colourPose(1), o.renderOptions()).bgr, cv::NORM_INF),
+      0.0);
+  EXPECT_GT(
+      cv::norm(f.bgr, render(seq.scene(), seq.poses()[1], o.renderOptions()).bgr, cv::NORM_INF),
+      0.0);
 }
 
 // A camera's auto exposure (--brightness-swing): each colour image is the constant one times the
 // sequence's brightness at its time, which stays within 1 +- the swing, changes smoothly and
 // depends on the seed; the depth and the poses are as without it.
 TEST(SynthTool, BrightnessSwingScalesTheColourAlone) {
-  const fs::path a = test::tempDir("synth_tool_constant"),
-                 b = test::tempDir("synth_tool_swinging");
+  const fs::path a = test::tempDir("synth_tool_constant"), b = test::tempDir("synth_tool_swinging");
   const std::string common = " --frames 3 --width 96 --height 72 --seed 4 --noise off";
   ASSERT_EQ(runTool("'" + a.string() + "'" + common), 0);
   ASSERT_EQ(runTool("'" + b.string() + "'" + common + " --brightness-swing 0.3"), 0);
@@ -299,13 +301,12 @@ TEST(SynthTool, VignettingDarkensTheColourTowardsTheCorners) {
 TEST(SynthTool, DepthNoiseCorrelationChangesTheDepthAlone) {
   const fs::path a = test::tempDir("synth_tool_noise_per_pixel"),
                  b = test::tempDir("synth_tool_noise_blobs"),
-                 c = test::tempDir("synth_tool_exact_blobs"),
-                 d = test::tempDir("synth_tool_exact");
+                 c = test::tempDir("synth_tool_exact_blobs"), d = test::tempDir("synth_tool_exact");
   const std::string common = " --frames 2 --width 96 --height 72 --seed 4";
   ASSERT_EQ(runTool("'" + a.string() + "'" + common), 0);
   ASSERT_EQ(runTool("'" + b.string() + "'" + common + " --depth-noise-correlation 3"), 0);
-  ASSERT_EQ(
-      runTool("'" + c.string() + "'" + common + " --noise off --depth-noise-correlation 3"), 0);
+  ASSERT_EQ(runTool("'" + c.string() + "'" + common + " --noise off --depth-noise-correlation 3"),
+            0);
   ASSERT_EQ(runTool("'" + d.string() + "'" + common + " --noise off"), 0);
   EXPECT_NE(readBytes(b / "rgb.txt").find("depth noise correlated over 3 px"), std::string::npos);
   EXPECT_EQ(readBytes(c / "rgb.txt").find("correlated"), std::string::npos);
@@ -342,8 +343,8 @@ TEST(SynthTool, RegisterColourUndoesAnUnregisteredColourCamera) {
             0);
   const fs::path script = test::sourceDir() / "scripts" / "register_colour";
   auto registerColour = [&](const fs::path& out, const std::string& options) {
-    const std::string command = "'" + script.string() + "' '" + u.string() + "' '" +
-                                out.string() + "' " + options + " >/dev/null 2>&1";
+    const std::string command = "'" + script.string() + "' '" + u.string() + "' '" + out.string() +
+                                "' " + options + " >/dev/null 2>&1";
     const int status = std::system(command.c_str());
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   };
@@ -366,6 +367,108 @@ TEST(SynthTool, RegisterColourUndoesAnUnregisteredColourCamera) {
   EXPECT_NE(registerColour(right, "--focal-ratio 0.897"), 0);  // exists
   EXPECT_NE(registerColour(root / "bad", "--focal-ratio 3"), 0);
   EXPECT_FALSE(fs::exists(root / "bad"));
+}
+
+// Runs scripts/NAME with `arguments`; returns its exit status.
+int runScript(const std::string& name, const std::string& arguments) {
+  const fs::path script = test::sourceDir() / "scripts" / name;
+  const std::string command = "'" + script.string() + "' " + arguments + " >/dev/null 2>&1";
+  const int status = std::system(command.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+// Mean absolute difference of two colour images over the pixels within `radius` of the
+// centre (in fractions of the half-diagonal).
+double centralDifference(const cv::Mat& x, const cv::Mat& y, double radius) {
+  double sum = 0.0;
+  int n = 0;
+  const double cx = 0.5 * (x.cols - 1), cy = 0.5 * (x.rows - 1), r = radius * std::hypot(cx, cy);
+  for (int v = 0; v < x.rows; ++v) {
+    for (int u = 0; u < x.cols; ++u) {
+      if (std::hypot(u - cx, v - cy) > r) continue;
+      const cv::Vec3b a = x.at<cv::Vec3b>(v, u), b = y.at<cv::Vec3b>(v, u);
+      for (int c = 0; c < 3; ++c) sum += std::abs(int(a[c]) - int(b[c]));
+      n += 3;
+    }
+  }
+  return sum / n;
+}
+
+// scripts/distort_tum puts a pinhole rendering through fr1's lens; loaded with the coefficients
+// it wrote, the frames are the rendering again (measured: 0.95 grey levels inside 80% of the
+// half-diagonal, the lens's resampling twice), without them 11.5; the depth likewise.
+TEST(SynthTool, DistortTumIsUndoneOnLoading) {
+  const fs::path pinhole = test::tempDir("synth_tool_pinhole"),
+                 root = test::tempDir("synth_tool_lens");
+  ASSERT_EQ(runTool("'" + pinhole.string() + "' --frames 1 --noise off"), 0);
+  const std::string lens = " --coefficients 0.2624,-0.9531,-0.0054,0.0026,1.1633";
+  const fs::path listed = root / "listed", unlisted = root / "unlisted";
+  ASSERT_EQ(runScript("distort_tum", "'" + pinhole.string() + "' '" + listed.string() + "'" + lens),
+            0);
+  ASSERT_EQ(runScript("distort_tum", "'" + pinhole.string() + "' '" + unlisted.string() + "'" +
+                                         lens + " --unlisted"),
+            0);
+  const Frame truth = TumDataset(pinhole.string()).loadFrame(0);
+  const TumDataset with_lens(listed.string()), without(unlisted.string());
+  EXPECT_TRUE(with_lens.distortion().any());
+  EXPECT_FALSE(without.distortion().any());
+  const Frame undistorted = with_lens.loadFrame(0), raw = without.loadFrame(0);
+  const double d_undistorted = centralDifference(undistorted.color, truth.color, 0.8);
+  const double d_raw = centralDifference(raw.color, truth.color, 0.8);
+  std::printf("  mean difference to the pinhole rendering: %.2f undistorted, %.2f raw\n",
+              d_undistorted, d_raw);
+  EXPECT_LT(d_undistorted, 2.0);
+  EXPECT_GT(d_raw, 3.0 * d_undistorted);
+  // Depth: the same depth at most pixels of the centre (nearest pixels twice: edges move by one).
+  int same = 0, seen = 0;
+  for (int v = 120; v < 360; ++v) {
+    for (int u = 160; u < 480; ++u) {
+      const float a = undistorted.depth.at<float>(v, u), b = truth.depth.at<float>(v, u);
+      if (!(b > 0.0f)) continue;
+      ++seen;
+      same += std::abs(a - b) < 1e-3f * b;
+    }
+  }
+  EXPECT_GT(same, 0.97 * seen);
+  EXPECT_NE(runScript("distort_tum", "'" + pinhole.string() + "' '" + listed.string() + "'" + lens),
+            0);  // exists
+  EXPECT_NE(runScript("distort_tum", "'" + pinhole.string() + "' '" + (root / "bad").string() +
+                                         "' --coefficients 1,2"),
+            0);
+  EXPECT_FALSE(fs::exists(root / "bad"));
+}
+
+// scripts/downsample_tum: half the size, intrinsics about the blocks' centres, each depth pixel
+// its block's nearest valid depth; a folder that exists or a size that does not divide refused.
+TEST(SynthTool, DownsampleTumHalvesTheFolder) {
+  const fs::path full = test::tempDir("synth_tool_full"), root = test::tempDir("synth_tool_half");
+  ASSERT_EQ(runTool("'" + full.string() + "' --frames 1 --width 160 --height 120"), 0);
+  const fs::path half = root / "half";
+  ASSERT_EQ(runScript("downsample_tum", "'" + full.string() + "' '" + half.string() + "'"), 0);
+  const TumDataset a(full.string()), b(half.string());
+  EXPECT_EQ(b.camera().width, 80);
+  EXPECT_EQ(b.camera().height, 60);
+  EXPECT_DOUBLE_EQ(b.camera().fx, a.camera().fx / 2);
+  EXPECT_DOUBLE_EQ(b.camera().cx, (a.camera().cx + 0.5) / 2 - 0.5);
+  EXPECT_DOUBLE_EQ(b.camera().depth_scale, a.camera().depth_scale);
+  const Frame fa = a.loadFrame(0), fb = b.loadFrame(0);
+  for (int v = 0; v < 60; ++v) {
+    for (int u = 0; u < 80; ++u) {
+      float nearest = 0.0f;
+      for (int dv = 0; dv < 2; ++dv) {
+        for (int du = 0; du < 2; ++du) {
+          const float z = fa.depth.at<float>(2 * v + dv, 2 * u + du);
+          if (z > 0.0f && (nearest == 0.0f || z < nearest)) nearest = z;
+        }
+      }
+      ASSERT_EQ(fb.depth.at<float>(v, u), nearest) << u << ", " << v;
+    }
+  }
+  EXPECT_NE(runScript("downsample_tum", "'" + full.string() + "' '" + half.string() + "'"), 0);
+  EXPECT_NE(runScript("downsample_tum",
+                      "'" + full.string() + "' '" + (root / "third").string() + "' --factor 3"),
+            0);  // 160 does not divide by 3
+  EXPECT_FALSE(fs::exists(root / "third"));
 }
 
 TEST(SynthTool, HelpAndBadOptions) {

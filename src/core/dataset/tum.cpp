@@ -9,7 +9,10 @@
 #include <fstream>
 #include <stdexcept>
 
+#include <yaml-cpp/yaml.h>
+#include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "acvo/depth.hpp"
 #include "stamp_association.hpp"
@@ -169,20 +172,84 @@ void writeTrajectory(const std::string& path, const Trajectory& trajectory,
   if (!out) throw std::runtime_error("error while writing " + path);
 }
 
+bool LensDistortion::any() const {
+  return std::any_of(coefficients.begin(), coefficients.end(), [](double k) { return k != 0.0; });
+}
+
+LensDistortion loadDistortionYaml(const std::string& path) {
+  YAML::Node node;
+  try {
+    node = YAML::LoadFile(path);
+  } catch (const std::exception& e) {
+    throw std::runtime_error("cannot read camera file " + path + ": " + e.what());
+  }
+  LensDistortion d;
+  auto number = [&](const YAML::Node& value, const std::string& key) {
+    try {
+      return value.as<double>();
+    } catch (const std::exception&) {
+      throw std::runtime_error(path + ": key '" + key + "' is not a number");
+    }
+  };
+  static const std::array<const char*, 5> opencv{"k1", "k2", "p1", "p2", "k3"};
+  static const std::array<const char*, 5> tum{"d0", "d1", "d2", "d3", "d4"};
+  for (std::size_t i = 0; i < 5; ++i) {
+    for (const char* key : {opencv[i], tum[i]}) {
+      if (node[key]) d.coefficients[i] = number(node[key], key);
+    }
+  }
+  if (YAML::Node list = node["distortion_coefficients"]) {
+    if (list.IsMap()) list = list["data"];
+    if (!list || !list.IsSequence() || list.size() > 5) {
+      throw std::runtime_error(path +
+                               ": key 'distortion_coefficients' is not a list of up to 5 numbers "
+                               "(k1 k2 p1 p2 k3)");
+    }
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      d.coefficients[i] = number(list[i], "distortion_coefficients");
+    }
+  }
+  return d;
+}
+
+LensDistortion distortionByName(const std::string& name) {
+  // vision.in.tum.de/data/datasets/rgbd-dataset/file_formats, "Intrinsic Camera Calibration".
+  LensDistortion d;
+  if (name == "fr1") d.coefficients = {0.2624, -0.9531, -0.0054, 0.0026, 1.1633};
+  if (name == "fr2") d.coefficients = {0.2312, -0.7849, -0.0033, -0.0001, 0.9172};
+  return d;
+}
+
 TumDataset::TumDataset(const std::string& folder, const std::string& camera) : folder_(folder) {
   const fs::path dir(folder);
   if (!fs::is_directory(dir)) throw std::runtime_error("dataset folder " + folder + " not found");
 
   if (camera.empty()) {
     const fs::path yaml = dir / "camera.yaml";
-    camera_ = fs::exists(yaml) ? loadCameraYaml(yaml.string()) : cameraByName("default");
+    if (fs::exists(yaml)) {
+      camera_ = loadCameraYaml(yaml.string());
+      distortion_ = loadDistortionYaml(yaml.string());
+    } else {
+      camera_ = cameraByName("default");
+    }
   } else if (camera == "fr1" || camera == "fr2" || camera == "fr3" || camera == "default") {
     camera_ = cameraByName(camera);
+    distortion_ = distortionByName(camera);
   } else if (fs::exists(camera)) {
     camera_ = loadCameraYaml(camera);
+    distortion_ = loadDistortionYaml(camera);
   } else {
     throw std::runtime_error("camera '" + camera +
                              "' is neither fr1, fr2, fr3, default nor a camera yaml file");
+  }
+
+  if (distortion_.any()) {
+    // OpenCV's undistortion maps, once: the same camera matrix, so that camera() stays the
+    // camera of the images loadFrame returns.
+    const cv::Matx33d K(camera_.fx, 0.0, camera_.cx, 0.0, camera_.fy, camera_.cy, 0.0, 0.0, 1.0);
+    cv::initUndistortRectifyMap(K, cv::Mat(distortion_.coefficients), cv::noArray(), K,
+                                cv::Size(camera_.width, camera_.height), CV_32FC1, undistort_x_,
+                                undistort_y_);
   }
 
   const fs::path associations = dir / "associations.txt";
@@ -229,6 +296,15 @@ Frame TumDataset::loadFrame(std::size_t i) const {
   frame.color = cv::imread(color_path, cv::IMREAD_COLOR);  // 8-bit BGR whatever the file holds
   if (frame.color.empty()) throw std::runtime_error("cannot load colour image " + color_path);
   checkSize(frame.color, color_path);
+  if (!undistort_x_.empty()) {
+    cv::Mat undistorted;
+    // Where no raw pixel saw, the colour of the nearest one that did: a black border would be
+    // an edge standing still in every frame, pulling both acvo's points and a dense peer's
+    // residuals towards no motion. The depth there stays unknown.
+    cv::remap(frame.color, undistorted, undistort_x_, undistort_y_, cv::INTER_LINEAR,
+              cv::BORDER_REPLICATE);
+    frame.color = undistorted;
+  }
 
   const cv::Mat raw = cv::imread(depth_path, cv::IMREAD_UNCHANGED);
   if (raw.empty()) throw std::runtime_error("cannot load depth image " + depth_path);
@@ -237,6 +313,13 @@ Frame TumDataset::loadFrame(std::size_t i) const {
                              ", expected a single-channel 16-bit (or 32-bit float) depth image");
   }
   checkSize(raw, depth_path);
+  if (!undistort_x_.empty()) {
+    cv::Mat undistorted;
+    cv::remap(raw, undistorted, undistort_x_, undistort_y_, cv::INTER_NEAREST, cv::BORDER_CONSTANT,
+              cv::Scalar::all(0));
+    frame.depth = depthToMeters(undistorted, camera_.depth_scale);
+    return frame;
+  }
   frame.depth = depthToMeters(raw, camera_.depth_scale);
   return frame;
 }
