@@ -33,8 +33,11 @@ struct Camera {
 // Throws std::invalid_argument for an unknown name.
 Camera cameraByName(const std::string& name);
 
-// Reads a camera.yaml (keys fx, fy, cx, cy, width, height, depth_scale; depth_scale optional,
-// default 5000). Throws std::runtime_error naming the file and the problem.
+// Reads a camera.yaml: fx, fy, cx, cy (or, as camera_calibration and OpenCV write it,
+// camera_matrix: a 3x3 matrix's 9 numbers, as a list or {data: [...]}), width and height (or
+// image_width, image_height; both absent: 0 x 0, for the caller to take from the images), and
+// depth_scale (optional, default 5000). Throws std::runtime_error naming the file and the
+// problem.
 Camera loadCameraYaml(const std::string& path);
 void saveCameraYaml(const std::string& path, const Camera& camera);
 

@@ -75,7 +75,8 @@ LensDistortion distortionByName(const std::string& name);
 class TumDataset {
  public:
   // `camera`: empty = camera.yaml in the folder if present, else "default"; a name
-  // (fr1, fr2, fr3, default) or a path to a camera yaml overrides it.
+  // (fr1, fr2, fr3, default) or a path to a camera yaml overrides it. A camera yaml without the
+  // image size takes the first colour image's.
   explicit TumDataset(const std::string& folder, const std::string& camera = "");
 
   const std::string& folder() const { return folder_; }

@@ -78,6 +78,41 @@ TEST(Camera, YamlDepthScaleDefaultsToTumPng) {
   EXPECT_DOUBLE_EQ(c.depth_scale, 5000.0);
 }
 
+// camera_calibration's file (and OpenCV's): image_width, camera_matrix {rows, cols, data}.
+TEST(Camera, YamlOfCameraCalibration) {
+  const auto dir = acvo::test::tempDir("camera_calibration_yaml");
+  writeText(dir / "c.yaml",
+            "image_width: 848\nimage_height: 480\ncamera_name: d435\ncamera_matrix:\n  rows: 3\n"
+            "  cols: 3\n  data: [421.5, 0, 424.2, 0, 422.0, 240.7, 0, 0, 1]\n"
+            "distortion_model: plumb_bob\ndistortion_coefficients:\n  rows: 1\n  cols: 5\n"
+            "  data: [0, 0, 0, 0, 0]\n");
+  const Camera c = acvo::loadCameraYaml((dir / "c.yaml").string());
+  EXPECT_DOUBLE_EQ(c.fx, 421.5);
+  EXPECT_DOUBLE_EQ(c.cx, 424.2);
+  EXPECT_DOUBLE_EQ(c.fy, 422.0);
+  EXPECT_DOUBLE_EQ(c.cy, 240.7);
+  EXPECT_EQ(c.width, 848);
+  EXPECT_EQ(c.height, 480);
+  writeText(dir / "list.yaml", "camera_matrix: [421.5, 0, 424.2, 0, 422.0, 240.7, 0, 0, 1]\n");
+  EXPECT_DOUBLE_EQ(acvo::loadCameraYaml((dir / "list.yaml").string()).fy, 422.0);
+  writeText(dir / "short.yaml", "camera_matrix: [421.5, 0, 424.2, 0, 422.0, 240.7, 0, 0]\n");
+  const std::string why = errorOf([&] { acvo::loadCameraYaml((dir / "short.yaml").string()); });
+  EXPECT_NE(why.find("camera_matrix"), std::string::npos) << why;
+}
+
+// Without a size the camera is 0 x 0, for the dataset to take from its images; half a size is
+// an error.
+TEST(Camera, YamlWithoutTheImageSize) {
+  const auto dir = acvo::test::tempDir("camera_no_size");
+  writeText(dir / "c.yaml", "fx: 500\nfy: 501\ncx: 300\ncy: 200\n");
+  const Camera c = acvo::loadCameraYaml((dir / "c.yaml").string());
+  EXPECT_EQ(c.width, 0);
+  EXPECT_EQ(c.height, 0);
+  writeText(dir / "half.yaml", "fx: 500\nfy: 501\ncx: 300\ncy: 200\nwidth: 600\n");
+  const std::string why = errorOf([&] { acvo::loadCameraYaml((dir / "half.yaml").string()); });
+  EXPECT_NE(why.find("height"), std::string::npos) << why;
+}
+
 TEST(Camera, YamlProblemsNameTheFileAndTheKey) {
   const auto dir = acvo::test::tempDir("camera_invalid");
   const std::string missing_key = (dir / "missing.yaml").string();

@@ -285,6 +285,15 @@ TEST(TumDataset, CameraNameOrYamlOverridesTheFolderCamera) {
   EXPECT_THROW(acvo::TumDataset(data.dir.string(), "no_such_camera.yaml"), std::runtime_error);
 }
 
+TEST(TumDataset, TakesTheImageSizeFromTheImagesWhenTheCameraFileHasNone) {
+  const TinyDataset data("tum_dataset_no_size");
+  writeText(data.dir / "camera.yaml", "fx: 4.5\nfy: 4.5\ncx: 1.5\ncy: 1.0\n");
+  const acvo::TumDataset dataset(data.dir.string());
+  EXPECT_EQ(dataset.camera().width, 4);
+  EXPECT_EQ(dataset.camera().height, 3);
+  EXPECT_FLOAT_EQ(dataset.loadFrame(1).depth.at<float>(1, 2), 1.5f);
+}
+
 TEST(TumDataset, DefaultCameraWithoutYaml) {
   const TinyDataset data("tum_dataset_default");
   fs::remove(data.dir / "camera.yaml");

@@ -51,14 +51,39 @@ Camera loadCameraYaml(const std::string& path) {
       throw std::runtime_error(path + ": key '" + key + "' is not a number");
     }
   };
-  get("fx", c.fx, true);
-  get("fy", c.fy, true);
-  get("cx", c.cx, true);
-  get("cy", c.cy, true);
-  get("width", c.width, true);
-  get("height", c.height, true);
+  if (YAML::Node matrix = node["camera_matrix"]; matrix && !node["fx"]) {
+    if (matrix.IsMap()) matrix = matrix["data"];
+    if (!matrix || !matrix.IsSequence() || matrix.size() != 9) {
+      throw std::runtime_error(path + ": key 'camera_matrix' is not a 3x3 matrix's 9 numbers");
+    }
+    double k[9];
+    for (std::size_t i = 0; i < 9; ++i) {
+      try {
+        k[i] = matrix[i].as<double>();
+      } catch (const std::exception&) {
+        throw std::runtime_error(path + ": key 'camera_matrix' is not a 3x3 matrix's 9 numbers");
+      }
+    }
+    c.fx = k[0], c.cx = k[2], c.fy = k[4], c.cy = k[5];
+  } else {
+    get("fx", c.fx, true);
+    get("fy", c.fy, true);
+    get("cx", c.cx, true);
+    get("cy", c.cy, true);
+  }
+  const bool named = node["image_width"] && !node["width"];
+  if (node["width"] || node["height"] || named) {
+    get(named ? "image_width" : "width", c.width, true);
+    get(named ? "image_height" : "height", c.height, true);
+  } else {
+    c.width = c.height = 0;  // the caller's to take from the images
+  }
   get("depth_scale", c.depth_scale, false);
-  if (!c.valid()) throw std::runtime_error(path + ": invalid intrinsics (non-positive values)");
+  Camera sized = c;
+  if (sized.width == 0 && sized.height == 0) sized.width = sized.height = 1;
+  if (!sized.valid()) {
+    throw std::runtime_error(path + ": invalid intrinsics (non-positive values)");
+  }
   return c;
 }
 
@@ -67,9 +92,8 @@ void saveCameraYaml(const std::string& path, const Camera& c) {
   if (!out) throw std::runtime_error("cannot write " + path);
   out.precision(17);
   out << "# pinhole intrinsics of the colour image; depth PNG units per metre\n"
-      << "width: " << c.width << "\nheight: " << c.height << "\nfx: " << c.fx
-      << "\nfy: " << c.fy << "\ncx: " << c.cx << "\ncy: " << c.cy
-      << "\ndepth_scale: " << c.depth_scale << "\n";
+      << "width: " << c.width << "\nheight: " << c.height << "\nfx: " << c.fx << "\nfy: " << c.fy
+      << "\ncx: " << c.cx << "\ncy: " << c.cy << "\ndepth_scale: " << c.depth_scale << "\n";
 }
 
 }  // namespace acvo

@@ -243,15 +243,6 @@ TumDataset::TumDataset(const std::string& folder, const std::string& camera) : f
                              "' is neither fr1, fr2, fr3, default nor a camera yaml file");
   }
 
-  if (distortion_.any()) {
-    // OpenCV's undistortion maps, once: the same camera matrix, so that camera() stays the
-    // camera of the images loadFrame returns.
-    const cv::Matx33d K(camera_.fx, 0.0, camera_.cx, 0.0, camera_.fy, camera_.cy, 0.0, 0.0, 1.0);
-    cv::initUndistortRectifyMap(K, cv::Mat(distortion_.coefficients), cv::noArray(), K,
-                                cv::Size(camera_.width, camera_.height), CV_32FC1, undistort_x_,
-                                undistort_y_);
-  }
-
   const fs::path associations = dir / "associations.txt";
   if (fs::exists(associations)) {
     frames_ = readAssociations(associations.string());
@@ -268,6 +259,23 @@ TumDataset::TumDataset(const std::string& folder, const std::string& camera) : f
 
   const fs::path groundtruth = dir / "groundtruth.txt";
   if (fs::exists(groundtruth)) groundtruth_ = readTrajectory(groundtruth.string());
+
+  if (camera_.width == 0 && camera_.height == 0 && !frames_.empty()) {
+    // A camera file without the image size: the first colour image's.
+    const std::string first = (dir / frames_.front().rgb.path).string();
+    const cv::Mat image = cv::imread(first, cv::IMREAD_UNCHANGED);
+    if (image.empty()) throw std::runtime_error("cannot load colour image " + first);
+    camera_.width = image.cols;
+    camera_.height = image.rows;
+  }
+  if (distortion_.any() && camera_.width > 0) {
+    // OpenCV's undistortion maps, once: the same camera matrix, so that camera() stays the
+    // camera of the images loadFrame returns.
+    const cv::Matx33d K(camera_.fx, 0.0, camera_.cx, 0.0, camera_.fy, camera_.cy, 0.0, 0.0, 1.0);
+    cv::initUndistortRectifyMap(K, cv::Mat(distortion_.coefficients), cv::noArray(), K,
+                                cv::Size(camera_.width, camera_.height), CV_32FC1, undistort_x_,
+                                undistort_y_);
+  }
 }
 
 Frame TumDataset::loadFrame(std::size_t i) const {
