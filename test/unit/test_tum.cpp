@@ -351,6 +351,9 @@ TEST(LensDistortion, ReadsTheKeysOfOpenCvTumAndRos) {
   writeText(dir / "camera.yaml", "k1: strong\n");
   std::string why = errorOf([&] { acvo::loadDistortionYaml((dir / "camera.yaml").string()); });
   EXPECT_TRUE(contains(why, "'k1'")) << why;
+  writeText(dir / "camera.yaml", "k2: .nan\n");
+  why = errorOf([&] { acvo::loadDistortionYaml((dir / "camera.yaml").string()); });
+  EXPECT_TRUE(contains(why, "'k2'")) << why;
   writeText(dir / "camera.yaml", "distortion_coefficients: [1, 2, 3, 4, 5, 6, 7, 8]\n");
   why = errorOf([&] { acvo::loadDistortionYaml((dir / "camera.yaml").string()); });
   EXPECT_TRUE(contains(why, "distortion_coefficients")) << why;

@@ -185,11 +185,13 @@ LensDistortion loadDistortionYaml(const std::string& path) {
   }
   LensDistortion d;
   auto number = [&](const YAML::Node& value, const std::string& key) {
+    double k = NAN;
     try {
-      return value.as<double>();
-    } catch (const std::exception&) {
-      throw std::runtime_error(path + ": key '" + key + "' is not a number");
+      k = value.as<double>();
+    } catch (const std::exception&) {  // not a number: k stays NaN
     }
+    if (!std::isfinite(k)) throw std::runtime_error(path + ": key '" + key + "' is not a number");
+    return k;
   };
   static const std::array<const char*, 5> opencv{"k1", "k2", "p1", "p2", "k3"};
   static const std::array<const char*, 5> tum{"d0", "d1", "d2", "d3", "d4"};
