@@ -110,15 +110,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   tolerateExceptions([] { checkTrajectory(acvo::readTrajectory(scratch(0))); });
   tolerateExceptions([] {
     // A camera without the image size is 0 x 0 (the dataset takes it from its images); all
-    // else must be valid.
-    acvo::Camera c = acvo::loadCameraYaml(scratch(0));
+    // else must be valid, and every distortion coefficient finite.
+    const acvo::CameraFile file = acvo::readCameraFile(scratch(0));
+    acvo::Camera c = file.camera;
     FUZZ_CHECK((c.width == 0) == (c.height == 0));
     if (c.width == 0) c.width = c.height = 1;
     FUZZ_CHECK(c.valid());
-  });
-  tolerateExceptions([] {
-    const acvo::LensDistortion d = acvo::loadDistortionYaml(scratch(0));
-    for (const double k : d.coefficients) FUZZ_CHECK(std::isfinite(k));
+    for (const double k : file.distortion.coefficients) FUZZ_CHECK(std::isfinite(k));
   });
   tolerateExceptions([&] { FUZZ_CHECK(acvo::validate(acvo::parseParams(text)).empty()); });
   return 0;

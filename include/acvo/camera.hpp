@@ -1,6 +1,7 @@
 // Pinhole intrinsics of the colour image, the depth scale, and back-projection.
 #pragma once
 
+#include <array>
 #include <string>
 
 #include <Eigen/Core>
@@ -33,11 +34,31 @@ struct Camera {
 // Throws std::invalid_argument for an unknown name.
 Camera cameraByName(const std::string& name);
 
-// Reads a camera.yaml: fx, fy, cx, cy (or, as camera_calibration and OpenCV write it,
-// camera_matrix: a 3x3 matrix's 9 numbers, as a list or {data: [...]}), width and height (or
-// image_width, image_height; both absent: 0 x 0, for the caller to take from the images), and
-// depth_scale (optional, default 5000). Throws std::runtime_error naming the file and the
-// problem.
+// A lens's radial-tangential distortion in OpenCV's order (ROS's plumb_bob): k1 k2 p1 p2 k3.
+struct LensDistortion {
+  std::array<double, 5> coefficients{};
+  bool any() const;
+};
+
+// TUM's published distortion of its raw fr1 and fr2 colour images; zero for fr3 (its images
+// were undistorted before publication) and default.
+LensDistortion distortionByName(const std::string& name);
+
+// What a camera.yaml says: the pinhole intrinsics and the lens they were calibrated with.
+struct CameraFile {
+  Camera camera;
+  LensDistortion distortion;
+};
+
+// Reads a camera.yaml once. Intrinsics: fx, fy, cx, cy (or, as camera_calibration and OpenCV
+// write it, camera_matrix: a 3x3 matrix's 9 numbers, as a list or {data: [...]}), width and
+// height (or image_width, image_height; both absent: 0 x 0, for the caller to take from the
+// images), and depth_scale (optional, default 5000). Distortion: k1 k2 p1 p2 k3, or d0 d1 d2
+// d3 d4 (TUM's names), or distortion_coefficients as a list or {data: [...]}; absent keys are
+// 0, and each given one must be a finite number. Throws std::runtime_error naming the file and
+// the problem.
+CameraFile readCameraFile(const std::string& path);
+// The intrinsics of readCameraFile.
 Camera loadCameraYaml(const std::string& path);
 void saveCameraYaml(const std::string& path, const Camera& camera);
 

@@ -1,7 +1,6 @@
 // TUM RGB-D benchmark formats: image lists, rgb/depth association, trajectories, datasets.
 #pragma once
 
-#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -55,20 +54,6 @@ Trajectory readTrajectory(const std::string& path);
 // Writes with the stamp text as given and full double precision.
 void writeTrajectory(const std::string& path, const Trajectory& trajectory,
                      const std::string& header_comment = "");
-
-// A lens's radial-tangential distortion in OpenCV's order (ROS's plumb_bob): k1 k2 p1 p2 k3.
-struct LensDistortion {
-  std::array<double, 5> coefficients{};
-  bool any() const;
-};
-
-// The distortion of a camera yaml file: keys k1 k2 p1 p2 k3, or d0 d1 d2 d3 d4 (TUM's names),
-// or distortion_coefficients as a list or as OpenCV's/ROS's {data: [...]}; absent keys are 0.
-// Throws std::runtime_error naming the file and key when a value is not a number.
-LensDistortion loadDistortionYaml(const std::string& path);
-// TUM's published distortion of its raw fr1 and fr2 colour images; zero for fr3 (its images
-// were undistorted before publication) and default.
-LensDistortion distortionByName(const std::string& name);
 
 // A TUM-format dataset folder: rgb.txt, depth.txt, optional associations.txt,
 // optional groundtruth.txt, optional camera.yaml.

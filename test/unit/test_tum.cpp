@@ -333,12 +333,14 @@ TEST(TumDataset, BadFilesAreNamed) {
 
 TEST(LensDistortion, ReadsTheKeysOfOpenCvTumAndRos) {
   const fs::path dir = acvo::test::tempDir("tum_distortion_keys");
+  const fs::path yaml = dir / "camera.yaml";
+  const std::string pinhole = "fx: 500\nfy: 500\ncx: 320\ncy: 240\n";
   auto read = [&](const std::string& text) {
-    writeText(dir / "camera.yaml", text);
-    return acvo::loadDistortionYaml((dir / "camera.yaml").string()).coefficients;
+    writeText(yaml, pinhole + text);
+    return acvo::readCameraFile(yaml.string()).distortion.coefficients;
   };
   const std::array<double, 5> expected{0.1, -0.2, 0.001, 0.002, 0.3};
-  EXPECT_EQ(read("fx: 500\nk1: 0.1\nk2: -0.2\np1: 0.001\np2: 0.002\nk3: 0.3\n"), expected);
+  EXPECT_EQ(read("k1: 0.1\nk2: -0.2\np1: 0.001\np2: 0.002\nk3: 0.3\n"), expected);
   EXPECT_EQ(read("d0: 0.1\nd1: -0.2\nd2: 0.001\nd3: 0.002\nd4: 0.3\n"), expected);
   // camera_calibration's and OpenCV's files: a matrix with its data.
   EXPECT_EQ(read("distortion_model: plumb_bob\ndistortion_coefficients:\n  rows: 1\n  cols: 5\n"
@@ -346,16 +348,20 @@ TEST(LensDistortion, ReadsTheKeysOfOpenCvTumAndRos) {
             expected);
   EXPECT_EQ(read("distortion_coefficients: [0.1, -0.2]\n"),
             (std::array<double, 5>{0.1, -0.2, 0.0, 0.0, 0.0}));
-  EXPECT_FALSE(acvo::LensDistortion{read("fx: 500\nfy: 500\n")}.any());
+  EXPECT_FALSE(acvo::LensDistortion{read("")}.any());
+  // The same one read gives the intrinsics.
+  writeText(yaml, pinhole + "k1: 0.1\n");
+  EXPECT_DOUBLE_EQ(acvo::readCameraFile(yaml.string()).camera.cx, 320.0);
 
-  writeText(dir / "camera.yaml", "k1: strong\n");
-  std::string why = errorOf([&] { acvo::loadDistortionYaml((dir / "camera.yaml").string()); });
+  auto error = [&](const std::string& text) {
+    writeText(yaml, pinhole + text);
+    return errorOf([&] { acvo::readCameraFile(yaml.string()); });
+  };
+  std::string why = error("k1: strong\n");
   EXPECT_TRUE(contains(why, "'k1'")) << why;
-  writeText(dir / "camera.yaml", "k2: .nan\n");
-  why = errorOf([&] { acvo::loadDistortionYaml((dir / "camera.yaml").string()); });
+  why = error("k2: .nan\n");
   EXPECT_TRUE(contains(why, "'k2'")) << why;
-  writeText(dir / "camera.yaml", "distortion_coefficients: [1, 2, 3, 4, 5, 6, 7, 8]\n");
-  why = errorOf([&] { acvo::loadDistortionYaml((dir / "camera.yaml").string()); });
+  why = error("distortion_coefficients: [1, 2, 3, 4, 5, 6, 7, 8]\n");
   EXPECT_TRUE(contains(why, "distortion_coefficients")) << why;
 
   EXPECT_TRUE(acvo::distortionByName("fr1").any());

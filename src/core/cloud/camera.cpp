@@ -1,6 +1,9 @@
-// Pinhole intrinsics: validity, the TUM cameras by name (fr1, fr2, fr3), camera.yaml read/write.
+// Pinhole intrinsics and lens: validity, the TUM cameras by name (fr1, fr2, fr3), camera.yaml
+// read/write.
 #include "acvo/camera.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <stdexcept>
@@ -32,59 +35,127 @@ Camera cameraByName(const std::string& name) {
   return c;
 }
 
-Camera loadCameraYaml(const std::string& path) {
-  YAML::Node node;
-  try {
-    node = YAML::LoadFile(path);
-  } catch (const std::exception& e) {
-    throw std::runtime_error("cannot read camera file " + path + ": " + e.what());
-  }
-  Camera c;
-  auto get = [&](const char* key, auto& value, bool required) {
-    if (!node[key]) {
-      if (required) throw std::runtime_error(path + ": missing key '" + key + "'");
-      return;
-    }
+bool LensDistortion::any() const {
+  return std::any_of(coefficients.begin(), coefficients.end(), [](double k) { return k != 0.0; });
+}
+
+LensDistortion distortionByName(const std::string& name) {
+  // vision.in.tum.de/data/datasets/rgbd-dataset/file_formats, "Intrinsic Camera Calibration".
+  LensDistortion d;
+  if (name == "fr1") d.coefficients = {0.2624, -0.9531, -0.0054, 0.0026, 1.1633};
+  if (name == "fr2") d.coefficients = {0.2312, -0.7849, -0.0033, -0.0001, 0.9172};
+  return d;
+}
+
+namespace {
+
+std::string notANumber(const std::string& key) {
+  return "key '" + key + "' is not a number";
+}
+
+// One camera file's YAML, and the way its errors name the file and the key.
+class CameraYaml {
+ public:
+  explicit CameraYaml(const std::string& path) : path_(path) {
     try {
-      value = node[key].as<std::decay_t<decltype(value)>>();
+      root_ = YAML::LoadFile(path);
+    } catch (const std::exception& e) {
+      throw std::runtime_error("cannot read camera file " + path + ": " + e.what());
+    }
+  }
+  YAML::Node operator[](const char* key) const { return root_[key]; }
+
+  [[noreturn]] void fail(const std::string& why) const {
+    throw std::runtime_error(path_ + ": " + why);
+  }
+  // `value` read as a T, or the error `why`.
+  template <typename T>
+  T as(const YAML::Node& value, const std::string& why) const {
+    try {
+      return value.as<T>();
     } catch (const std::exception&) {
-      throw std::runtime_error(path + ": key '" + key + "' is not a number");
+      fail(why);
     }
-  };
-  if (YAML::Node matrix = node["camera_matrix"]; matrix && !node["fx"]) {
+  }
+  // The key's value into `value`; an absent key is an error when required, else leaves it.
+  template <typename T>
+  void get(const char* key, T& value, bool required) const {
+    if (root_[key]) {
+      value = as<T>(root_[key], notANumber(key));
+    } else if (required) {
+      fail(std::string("missing key '") + key + "'");
+    }
+  }
+
+ private:
+  std::string path_;
+  YAML::Node root_;
+};
+
+Camera intrinsicsOf(const CameraYaml& yaml) {
+  Camera c;
+  if (YAML::Node matrix = yaml["camera_matrix"]; matrix && !yaml["fx"]) {
+    const std::string why = "key 'camera_matrix' is not a 3x3 matrix's 9 numbers";
     if (matrix.IsMap()) matrix = matrix["data"];
-    if (!matrix || !matrix.IsSequence() || matrix.size() != 9) {
-      throw std::runtime_error(path + ": key 'camera_matrix' is not a 3x3 matrix's 9 numbers");
-    }
-    double k[9];
-    for (std::size_t i = 0; i < 9; ++i) {
-      try {
-        k[i] = matrix[i].as<double>();
-      } catch (const std::exception&) {
-        throw std::runtime_error(path + ": key 'camera_matrix' is not a 3x3 matrix's 9 numbers");
-      }
-    }
+    if (!matrix || !matrix.IsSequence() || matrix.size() != 9) yaml.fail(why);
+    std::array<double, 9> k{};
+    for (std::size_t i = 0; i < k.size(); ++i) k[i] = yaml.as<double>(matrix[i], why);
     c.fx = k[0], c.cx = k[2], c.fy = k[4], c.cy = k[5];
   } else {
-    get("fx", c.fx, true);
-    get("fy", c.fy, true);
-    get("cx", c.cx, true);
-    get("cy", c.cy, true);
+    yaml.get("fx", c.fx, true);
+    yaml.get("fy", c.fy, true);
+    yaml.get("cx", c.cx, true);
+    yaml.get("cy", c.cy, true);
   }
-  const bool named = node["image_width"] && !node["width"];
-  if (node["width"] || node["height"] || named) {
-    get(named ? "image_width" : "width", c.width, true);
-    get(named ? "image_height" : "height", c.height, true);
+  const bool named = yaml["image_width"] && !yaml["width"];
+  if (yaml["width"] || yaml["height"] || named) {
+    yaml.get(named ? "image_width" : "width", c.width, true);
+    yaml.get(named ? "image_height" : "height", c.height, true);
   } else {
     c.width = c.height = 0;  // the caller's to take from the images
   }
-  get("depth_scale", c.depth_scale, false);
+  yaml.get("depth_scale", c.depth_scale, false);
   Camera sized = c;
   if (sized.width == 0 && sized.height == 0) sized.width = sized.height = 1;
-  if (!sized.valid()) {
-    throw std::runtime_error(path + ": invalid intrinsics (non-positive values)");
-  }
+  if (!sized.valid()) yaml.fail("invalid intrinsics (non-positive values)");
   return c;
+}
+
+LensDistortion distortionOf(const CameraYaml& yaml) {
+  LensDistortion d;
+  auto coefficient = [&](const YAML::Node& value, const std::string& key) {
+    const double k = yaml.as<double>(value, notANumber(key));
+    if (!std::isfinite(k)) yaml.fail(notANumber(key));
+    return k;
+  };
+  static const std::array<const char*, 5> opencv{"k1", "k2", "p1", "p2", "k3"};
+  static const std::array<const char*, 5> tum{"d0", "d1", "d2", "d3", "d4"};
+  for (std::size_t i = 0; i < d.coefficients.size(); ++i) {
+    for (const char* key : {opencv[i], tum[i]}) {
+      if (yaml[key]) d.coefficients[i] = coefficient(yaml[key], key);
+    }
+  }
+  if (YAML::Node list = yaml["distortion_coefficients"]) {
+    if (list.IsMap()) list = list["data"];
+    if (!list || !list.IsSequence() || list.size() > d.coefficients.size()) {
+      yaml.fail("key 'distortion_coefficients' is not a list of up to 5 numbers (k1 k2 p1 p2 k3)");
+    }
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      d.coefficients[i] = coefficient(list[i], "distortion_coefficients");
+    }
+  }
+  return d;
+}
+
+}  // namespace
+
+CameraFile readCameraFile(const std::string& path) {
+  const CameraYaml yaml(path);
+  return {intrinsicsOf(yaml), distortionOf(yaml)};
+}
+
+Camera loadCameraYaml(const std::string& path) {
+  return readCameraFile(path).camera;
 }
 
 void saveCameraYaml(const std::string& path, const Camera& c) {

@@ -9,7 +9,6 @@
 #include <fstream>
 #include <stdexcept>
 
-#include <yaml-cpp/yaml.h>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -172,56 +171,6 @@ void writeTrajectory(const std::string& path, const Trajectory& trajectory,
   if (!out) throw std::runtime_error("error while writing " + path);
 }
 
-bool LensDistortion::any() const {
-  return std::any_of(coefficients.begin(), coefficients.end(), [](double k) { return k != 0.0; });
-}
-
-LensDistortion loadDistortionYaml(const std::string& path) {
-  YAML::Node node;
-  try {
-    node = YAML::LoadFile(path);
-  } catch (const std::exception& e) {
-    throw std::runtime_error("cannot read camera file " + path + ": " + e.what());
-  }
-  LensDistortion d;
-  auto number = [&](const YAML::Node& value, const std::string& key) {
-    double k = NAN;
-    try {
-      k = value.as<double>();
-    } catch (const std::exception&) {  // not a number: k stays NaN
-    }
-    if (!std::isfinite(k)) throw std::runtime_error(path + ": key '" + key + "' is not a number");
-    return k;
-  };
-  static const std::array<const char*, 5> opencv{"k1", "k2", "p1", "p2", "k3"};
-  static const std::array<const char*, 5> tum{"d0", "d1", "d2", "d3", "d4"};
-  for (std::size_t i = 0; i < 5; ++i) {
-    for (const char* key : {opencv[i], tum[i]}) {
-      if (node[key]) d.coefficients[i] = number(node[key], key);
-    }
-  }
-  if (YAML::Node list = node["distortion_coefficients"]) {
-    if (list.IsMap()) list = list["data"];
-    if (!list || !list.IsSequence() || list.size() > 5) {
-      throw std::runtime_error(path +
-                               ": key 'distortion_coefficients' is not a list of up to 5 numbers "
-                               "(k1 k2 p1 p2 k3)");
-    }
-    for (std::size_t i = 0; i < list.size(); ++i) {
-      d.coefficients[i] = number(list[i], "distortion_coefficients");
-    }
-  }
-  return d;
-}
-
-LensDistortion distortionByName(const std::string& name) {
-  // vision.in.tum.de/data/datasets/rgbd-dataset/file_formats, "Intrinsic Camera Calibration".
-  LensDistortion d;
-  if (name == "fr1") d.coefficients = {0.2624, -0.9531, -0.0054, 0.0026, 1.1633};
-  if (name == "fr2") d.coefficients = {0.2312, -0.7849, -0.0033, -0.0001, 0.9172};
-  return d;
-}
-
 TumDataset::TumDataset(const std::string& folder, const std::string& camera) : folder_(folder) {
   const fs::path dir(folder);
   if (!fs::is_directory(dir)) throw std::runtime_error("dataset folder " + folder + " not found");
@@ -229,8 +178,9 @@ TumDataset::TumDataset(const std::string& folder, const std::string& camera) : f
   if (camera.empty()) {
     const fs::path yaml = dir / "camera.yaml";
     if (fs::exists(yaml)) {
-      camera_ = loadCameraYaml(yaml.string());
-      distortion_ = loadDistortionYaml(yaml.string());
+      const CameraFile file = readCameraFile(yaml.string());
+      camera_ = file.camera;
+      distortion_ = file.distortion;
     } else {
       camera_ = cameraByName("default");
     }
@@ -238,8 +188,9 @@ TumDataset::TumDataset(const std::string& folder, const std::string& camera) : f
     camera_ = cameraByName(camera);
     distortion_ = distortionByName(camera);
   } else if (fs::exists(camera)) {
-    camera_ = loadCameraYaml(camera);
-    distortion_ = loadDistortionYaml(camera);
+    const CameraFile file = readCameraFile(camera);
+    camera_ = file.camera;
+    distortion_ = file.distortion;
   } else {
     throw std::runtime_error("camera '" + camera +
                              "' is neither fr1, fr2, fr3, default nor a camera yaml file");
