@@ -130,6 +130,8 @@ const ColourDepthCheck::Verdict& ColourDepthCheck::add(const Frame& frame) {
   return verdict_;
 }
 
+bool ColourDepthCheck::atGridEnd(int i) { return i < kGridEnd || i >= kRatios - kGridEnd; }
+
 void ColourDepthCheck::decide() {
   const int best = int(std::max_element(sum_.begin(), sum_.end()) - sum_.begin());
   const int one = kRatios / 2;  // ratio 1.00
@@ -141,7 +143,7 @@ void ColourDepthCheck::decide() {
   const int near = int(std::count_if(frame_best_.begin(), frame_best_.end(),
                                      [&](int b) { return std::abs(b - best) <= within; }));
   verdict_.agreement = double(near) / double(frame_best_.size());
-  const bool unregistered = std::abs(best - one) >= steps(options_.min_offset) &&
+  const bool unregistered = !atGridEnd(best) && std::abs(best - one) >= steps(options_.min_offset) &&
                             verdict_.gain >= options_.min_gain &&
                             verdict_.agreement >= options_.min_agreement;
   verdict_.state = unregistered ? State::kUnregistered : State::kRegistered;
@@ -188,6 +190,15 @@ std::string ColourDepthCheck::describe() const {
                     v.frames, v.frames_seen);
       break;
     case State::kRegistered:
+      if (atGridEnd(int(std::lround((v.best_ratio - ratioAt(0)) / kRatioStep)))) {
+        std::snprintf(text, sizeof text,
+                      "colour/depth registration: taken as registered, no focal ratio stands out "
+                      "(the colour edges' score still climbs at the search's end, ratio %.2f, "
+                      "%.2fx ratio 1's score, %d frames). If the depth comes from a second "
+                      "camera, register it to the colour (depth_image_proc/register)",
+                      v.best_ratio, v.gain, v.frames);
+        break;
+      }
       std::snprintf(text, sizeof text,
                     "colour/depth registration: the colour edges lie on the depth edges (best "
                     "focal ratio %.2f, %.2fx ratio 1's score, %d frames)",
