@@ -24,6 +24,10 @@ struct SelectionParams {
   double max_depth = 10.0;     // m (paper: no limit): far points pin the rotation; their coarse
                                // depth is modelled along the ray (depth_noise)
   bool canny_fallback = true;  // add Canny edge pixels when fewer than target/3 were selected
+  // target_points is for a 640x480 image; another size aims at target_points times its width
+  // over 640 (the square root of its pixels over 640x480's): edges, where points are chosen,
+  // grow with the width, and a dense peer's cost with the pixels.
+  bool scale_with_image = true;
 };
 
 struct RegistrationParams {
@@ -213,6 +217,7 @@ void visitParams(Params_& p, Visitor&& visit) {
   visit("selection", "min_depth", p.selection.min_depth);
   visit("selection", "max_depth", p.selection.max_depth);
   visit("selection", "canny_fallback", p.selection.canny_fallback);
+  visit("selection", "scale_with_image", p.selection.scale_with_image);
   visit("registration", "engine", p.registration.engine);
   auto& c = p.coarse_to_fine;
   visit("coarse_to_fine", "ell_init", c.ell_init);

@@ -27,9 +27,13 @@ struct SelectableDepth {
   float min, max;
 };
 
+// The number of points the selector aims at in an image of `size`: target_points, scaled by
+// the image's size when scale_with_image (at least 1 point).
+int targetPoints(const SelectionParams& params, cv::Size size);
+
 // gray: CV_8UC1; depth: CV_32FC1 metres, 0 = invalid (same size). Deterministic for a given
-// input. Pixels within 4 px of the border and pixels whose depth is invalid or outside
-// [min_depth, max_depth] are never returned.
+// input. Aims at targetPoints(params, gray.size()) pixels. Pixels within 4 px of the border and
+// pixels whose depth is invalid or outside [min_depth, max_depth] are never returned.
 Selection selectPixels(const cv::Mat& gray, const cv::Mat& depth, const SelectionParams& params);
 
 }  // namespace acvo

@@ -231,6 +231,7 @@ Params paperParams() {
   Params p;
   p.registration.engine = Engine::kPaper;
   p.selection.target_points = 3000;
+  p.selection.scale_with_image = false;  // the authors' 3000 at every size
   // The authors' code keeps every valid depth (a 6 m cap moves teddy200 by 3% in translation
   // and 6% in rotation: docs/method.md §4).
   p.selection.max_depth = 100.0;

@@ -53,7 +53,7 @@ Fused fromExample(const std::string& file, const std::string& sensor) {
 // `lost_frames` frames without valid depth (0.1 s apart).
 std::vector<nav_msgs::Odometry> acvoMessages(int tracked_frames, int lost_frames) {
   acvo::Params params;
-  params.selection.target_points = 1500;  // 320x240: quick
+  params.selection.target_points = 3000;  // 1500 at 320x240: quick
   acvo::Odometry odometry(params);
   const acvo::Camera camera = acvo_test::testCamera();
   Eigen::Isometry3d base_from_camera = Eigen::Isometry3d::Identity();

@@ -1168,7 +1168,7 @@ TEST(OdometryNodelet, ReconfigureRestartsTrackingWithNewParametersAndRefusesBadO
   std::vector<Outcome> before = client->run(range(0, 3));
   ASSERT_TRUE(before.back().odom);
   const std::uint32_t points = before.back().info->moving_points;
-  ASSERT_GT(points, 1000u);  // target_points 1500 in test_params.yaml
+  ASSERT_GT(points, 1000u);  // target_points 3000 in test_params.yaml: 1500 at 320x240
 
   reconfigure("target_points", 500, true);
   std::vector<Outcome> after = client->run(range(3, 6));
@@ -1195,7 +1195,7 @@ TEST(OdometryNodelet, ReconfigureRestartsTrackingWithNewParametersAndRefusesBadO
   EXPECT_TRUE(isTracking(refused[0].info->tracking)) << refused[0].info->tracking;
   EXPECT_LT(refused[0].info->moving_points, 700u);
 
-  reconfigure("target_points", 1500, true);
+  reconfigure("target_points", 3000, true);
 }
 
 // Sets one parameter through the dynamic_reconfigure server; `list` is the request's list of
@@ -1424,10 +1424,11 @@ TEST(OdometryNodelet, ABinnedStreamIsMeasuredWithItsProjectionMatrix) {
   }
 }
 
-// The .test sets a valid selection/target_points (600), an invalid coarse_to_fine/ell_min (-1)
-// and an unknown frame_id. The bad value alone is rejected (before, one bad value put every
-// parameter back to its default: 1500 points from test_params.yaml's would have been lost too);
-// the unknown name is reported with the name it has here. Both stay in diagnostics.
+// The .test sets a valid selection/target_points (1200: 600 at 320x240), an invalid
+// coarse_to_fine/ell_min (-1) and an unknown frame_id. The bad value alone is rejected (before,
+// one bad value put every parameter back to its default: 1500 points from test_params.yaml's
+// would have been lost too); the unknown name is reported with the name it has here. Both stay
+// in diagnostics.
 TEST(OdometryNodelet, ABadParameterIsRejectedAloneAndAnUnknownOneIsNamed) {
   if (!client->bad_params_) GTEST_SKIP() << "needs nodelet_inputs.test";
   ASSERT_TRUE(client->reset());

@@ -83,6 +83,29 @@ TEST(PointSelector, CountOnTexturedImageIsWithinFivePercentOfTarget) {
   }
 }
 
+// target_points is for 640x480: edges, where points are chosen, grow with the image's width.
+TEST(PointSelector, TheTargetScalesWithTheImageWidth) {
+  SelectionParams params;
+  params.target_points = 4000;
+  EXPECT_EQ(targetPoints(params, cv::Size(640, 480)), 4000);
+  EXPECT_EQ(targetPoints(params, cv::Size(320, 240)), 2000);
+  EXPECT_EQ(targetPoints(params, cv::Size(1280, 720)), 6928);  // 4000 sqrt(3)
+  EXPECT_EQ(targetPoints(params, cv::Size(8, 6)), 50);
+  EXPECT_EQ(targetPoints(params, cv::Size(1, 1)), 7);
+  params.target_points = 1;
+  EXPECT_EQ(targetPoints(params, cv::Size(1, 1)), 1);  // never none
+
+  params.target_points = 3000;
+  for (const bool scale : {true, false}) {
+    params.scale_with_image = scale;
+    const cv::Mat gray = texturedImage(320, 240, 5);
+    const Selection s = selectPixels(gray, constantDepth(gray.size(), 2.f), params);
+    const double expected = scale ? 1500.0 : 3000.0;
+    EXPECT_NEAR(static_cast<double>(s.pixels.size()), expected, 0.05 * expected) << scale;
+    EXPECT_EQ(targetPoints(params, gray.size()), int(expected));
+  }
+}
+
 TEST(PointSelector, BorderIsNeverSelected) {
   // Strong gradients right at the edge of the image: the frame would attract the selector.
   cv::Mat gray = texturedImage(320, 240, 11);
@@ -205,10 +228,12 @@ TEST(PointSelector, OddSizedViewGivesTheSameAsItsCopy) {
   const cv::Mat depth = constantDepth(view.size(), 2.f);
   SelectionParams params;
   params.target_points = 1000;
+  const int target = targetPoints(params, view.size());
+  EXPECT_EQ(target, 522);  // 1000 sqrt(333 x 251 / (640 x 480))
   const Selection a = selectPixels(view, depth, params);
   const Selection b = selectPixels(view.clone(), depth, params);
   EXPECT_EQ(a.pixels, b.pixels);
-  EXPECT_NEAR(static_cast<double>(a.pixels.size()), 1000, 50);
+  EXPECT_NEAR(static_cast<double>(a.pixels.size()), target, 0.05 * target);
   for (const cv::Point& p : a.pixels) {
     ASSERT_TRUE(p.x >= 4 && p.y >= 4 && p.x < view.cols - 4 && p.y < view.rows - 4) << p;
   }

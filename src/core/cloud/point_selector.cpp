@@ -331,6 +331,13 @@ std::size_t densePassCount(const cv::Mat& gray) {
 }
 }  // namespace selection
 
+int targetPoints(const SelectionParams& params, cv::Size size) {
+  if (!params.scale_with_image || params.target_points <= 0) return params.target_points;
+  constexpr double kReferencePixels = 640.0 * 480.0;
+  const double scale = std::sqrt(double(size.area()) / kReferencePixels);
+  return std::max(1, int(std::lround(params.target_points * scale)));
+}
+
 Selection selectPixels(const cv::Mat& gray, const cv::Mat& depth, const SelectionParams& params) {
   if (gray.type() != CV_8UC1) throw std::invalid_argument("selectPixels: grey image must be 8UC1");
   if (depth.type() != CV_32FC1 || depth.size() != gray.size()) {
@@ -338,14 +345,14 @@ Selection selectPixels(const cv::Mat& gray, const cv::Mat& depth, const Selectio
   }
   Selection out;
   const Rect interior = interiorOf(gray);
-  if (interior.empty() || params.target_points <= 0) return out;
+  const int target = targetPoints(params, gray.size());
+  if (interior.empty() || target <= 0) return out;
 
   const CandidatePyramid pyr = selection::candidateMaps(gray);
-  std::vector<int> picks =
-      adaptiveSelect({gray, pyr, interior}, params.target_points, out.cell_size);
+  std::vector<int> picks = adaptiveSelect({gray, pyr, interior}, target, out.cell_size);
   out.gradient_pixels = static_cast<int>(picks.size());
 
-  if (params.canny_fallback && 3 * out.gradient_pixels < params.target_points) {
+  if (params.canny_fallback && 3 * out.gradient_pixels < target) {
     std::vector<std::uint8_t> taken(static_cast<std::size_t>(gray.cols) * gray.rows, 0);
     for (int idx : picks) taken[idx] = 1;
     const std::vector<int> edges = cannyPixels(gray, interior, taken);
