@@ -40,11 +40,12 @@ class ColourDepthCheck {
   static constexpr int kRatios = 41;  // 0.80, 0.81, ... 1.20
   static constexpr double kRatioStep = 0.01;
   static double ratioAt(int i) { return 0.8 + kRatioStep * i; }
-  // A best ratio this many steps from either end of the grid (0.80, 0.81; 1.19, 1.20) is not
+  // A best ratio within this many steps of either end of the grid (0.80-0.83, 1.17-1.20) is not
   // taken for a camera: texture beside the silhouettes can make the score climb steadily across
   // the grid, with no peak (a rendered room at 0.897: its score rose from 0.58 at 0.89 to 1.18
-  // at 1.20; resampled by 1.20, acvo lost 2.5x).
-  static constexpr int kGridEnd = 2;
+  // at 1.20, and its next ten frames peaked at 1.18; resampled by 1.20, acvo lost 3x). Cameras
+  // found lay at 0.85-0.93 and 1.11.
+  static constexpr int kGridEnd = 4;
   static bool atGridEnd(int i);
   // Odometry gives it every kFrameStep-th frame until it decides. Every frame: the verdict
   // comes at the tenth frame with enough depth edges, so that colour from a second camera is

@@ -115,15 +115,17 @@ TEST(ColourDepthCheck, AScoreClimbingToTheGridsEndIsNoCamera) {
     check.add(sequence.frame(i).toFrame());
   }
   const auto& v = check.verdict();
-  EXPECT_GE(v.best_ratio, ColourDepthCheck::ratioAt(ColourDepthCheck::kRatios - 2) - 1e-9);
+  EXPECT_GE(v.best_ratio, ColourDepthCheck::ratioAt(ColourDepthCheck::kRatios - 4) - 1e-9);
   EXPECT_GT(v.gain, 1.15);  // measured 1.20: by gain and offset alone, "unregistered"
   EXPECT_EQ(v.state, State::kRegistered);
   EXPECT_EQ(v.baseline, 0.0);
   EXPECT_NE(check.describe().find("no focal ratio stands out"), std::string::npos)
       << check.describe();
   EXPECT_TRUE(ColourDepthCheck::atGridEnd(0));
-  EXPECT_TRUE(ColourDepthCheck::atGridEnd(ColourDepthCheck::kRatios - 1));
+  EXPECT_TRUE(ColourDepthCheck::atGridEnd(3));  // 0.83
+  EXPECT_TRUE(ColourDepthCheck::atGridEnd(ColourDepthCheck::kRatios - 4));  // 1.17
   EXPECT_FALSE(ColourDepthCheck::atGridEnd(5));  // 0.85, a rendered room's camera found
+  EXPECT_FALSE(ColourDepthCheck::atGridEnd(31));  // 1.11, another
 }
 
 TEST(ColourDepthCheck, AnUnregisteredColourCameraIsFoundWithItsBaseline) {
