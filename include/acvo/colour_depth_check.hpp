@@ -14,17 +14,17 @@
 // fr3/teddy: 1.01, 1.04x the score at 1; every rendered sequence of docs/accuracy.md within
 // 0.01 of 1), an unregistered one away from it (7-Scenes' kitchen: 0.91, 1.6x; rendered at
 // 0.897: 0.88-0.90, 1.3-1.6x; at 1.1: 1.10, 1.27x), but not at the grid's ends (kGridEnd). The
-// verdict rests on that one-parameter search alone. Once unregistered, the frames' evidence is searched again for the colour camera
-// itself: its focal ratio within 0.03 of the one found and its centre up to max_baseline along x
-// (a Kinect's two cameras are 2.5 cm apart), each edge pixel's point (its depth known) projected
-// into it: u' = cx + ratio (u - cx) - ratio fx baseline / z. With the depth, the baseline's
-// shift differs from silhouette to silhouette by their depths, which a texture does not mimic
-// (rendered rooms at 0.897 and 2.5 cm: found within 1 cm and 0.01; the ratio alone had come out
-// 0.85-0.96, the baseline biasing it; docs/accuracy.md, fifteenth round). Colour and depth of
-// two instants (free-running streams) misalign by the motion between them: Odometry, which runs
-// the check, gives it the depth as it registered it (depthAsRegistered, odometry.hpp), and
-// resamples an unregistered camera's colour by the ratio found, or by the camera found where
-// asked (withColourResampled, below; OdometryParams::resample_colour_baseline).
+// verdict rests on that one-parameter search alone. Once unregistered, the frames' evidence is
+// searched again for the colour camera itself: its focal ratio within 0.03 of the one found and
+// its centre up to max_baseline along x (a Kinect's two cameras are 2.5 cm apart), each edge
+// pixel's point (its depth known) projected into it:
+// u' = cx + ratio (u - cx) - ratio fx baseline / z. With the depth, the baseline's shift differs from silhouette to silhouette by their depths,
+// which a texture does not mimic (rendered rooms at 0.897 and 2.5 cm: found within 1 cm and 0.01;
+// the ratio alone had come out 0.85-0.96, the baseline biasing it; docs/accuracy.md, fifteenth
+// round). Colour and depth of two instants (free-running streams) misalign by the motion between
+// them: Odometry, which runs the check, gives it the depth as it registered it (depthAsRegistered,
+// odometry.hpp), and resamples an unregistered camera's colour by the ratio found, or by the camera
+// found where asked (withColourResampled, below; OdometryParams::resample_colour_baseline).
 #pragma once
 
 #include <array>

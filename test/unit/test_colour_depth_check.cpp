@@ -98,14 +98,10 @@ TEST(ColourDepthCheck, AnUnregisteredColourCameraIsFoundWithItsFocalLength) {
   }
 }
 
-// The colour camera itself, once unregistered: 7-Scenes' (0.897, its centre 2.5 cm along x) and
-// one of a longer focal length, a centre on the other side, on exact depth and with Kinect
-// noise in blobs; a registered room keeps baseline 0 (no search). Not found: 1.1 with -2 cm on
-// this room (1.12, 0: docs/accuracy.md, fifteenth round).
 // A room (seed 54) whose texture beside the silhouettes makes the score climb across the whole
 // grid, from 0.58 of ratio 1's at 0.89 to 1.2x at 1.20, with no peak at its camera's 0.897:
-// taken for a camera of ratio 1.20, its colour resampled by that cost acvo 2.5x in translation
-// (0.0253 -> 0.0804 m/s). A best ratio at the grid's end is no camera found.
+// taken for a camera of ratio 1.20, its colour resampled by that cost acvo 3x in translation
+// (0.0253 -> 0.0804 m/s). A best ratio at the grid's ends (kGridEnd) is no camera found.
 TEST(ColourDepthCheck, AScoreClimbingToTheGridsEndIsNoCamera) {
   synth::SequenceOptions o = exactRoom(0.897, 0.025);
   o.seed = 54;
@@ -128,6 +124,10 @@ TEST(ColourDepthCheck, AScoreClimbingToTheGridsEndIsNoCamera) {
   EXPECT_FALSE(ColourDepthCheck::atGridEnd(31));  // 1.11, another
 }
 
+// The colour camera itself, once unregistered: 7-Scenes' (0.897, its centre 2.5 cm along x) and
+// one of a longer focal length, a centre on the other side, on exact depth and with Kinect
+// noise in blobs; a registered room keeps baseline 0 (no search). Not found: 1.1 with -2 cm on
+// this room (1.12, 0: docs/accuracy.md, fifteenth round).
 TEST(ColourDepthCheck, AnUnregisteredColourCameraIsFoundWithItsBaseline) {
   struct Case {
     double ratio, baseline;

@@ -143,7 +143,8 @@ void ColourDepthCheck::decide() {
   const int near = int(std::count_if(frame_best_.begin(), frame_best_.end(),
                                      [&](int b) { return std::abs(b - best) <= within; }));
   verdict_.agreement = double(near) / double(frame_best_.size());
-  const bool unregistered = !atGridEnd(best) && std::abs(best - one) >= steps(options_.min_offset) &&
+  const bool unregistered = !atGridEnd(best) &&
+                            std::abs(best - one) >= steps(options_.min_offset) &&
                             verdict_.gain >= options_.min_gain &&
                             verdict_.agreement >= options_.min_agreement;
   verdict_.state = unregistered ? State::kUnregistered : State::kRegistered;
