@@ -66,6 +66,9 @@ struct SceneOptions {
   // surface (with structure off: a uniform image, nothing to track).
   bool texture = true;
   std::uint64_t seed = 1;  // geometry and materials; same seed -> same scene
+  // true: one more material, the last, for a person walking through the room (walkerAt);
+  // the scene's own geometry and materials are those of walker off.
+  bool walker = false;
 };
 
 struct Scene {
@@ -80,6 +83,15 @@ struct Scene {
 // random streams, so structure on/off and texture on/off of one seed share what they can
 // (e.g. texture off keeps the exact geometry of texture on).
 Scene makeScene(const SceneOptions& options);
+
+// A person walking back and forth across the room in front of the furniture, the scene's one
+// moving object (TUM's fr3/walking sequences hold two): a box of a person's size (0.5 m wide,
+// 0.3 m deep, 1.7 m tall) standing on the floor at y = 0.6 m, about 1.2 m in front of the
+// start pose, its centre at x = 1.8 m sin(w t), w such that its mean speed is `speed` (m/s).
+// At t = 0 it stands in the middle of the start's view (a third of the image), and it is in
+// view about a third of the time. Its colour is material `material` (makeScene with walker
+// on: the last).
+Box walkerAt(double speed, double t, int material);
 
 // Nearest intersection with t > 0 of `ray` with the scene; false when the ray escapes.
 bool intersect(const Scene& scene, const Ray& ray, Hit* hit);

@@ -181,7 +181,22 @@ Scene makeScene(const SceneOptions& options) {
   addFurniture(scene, geometry, 6);
   const int used = static_cast<int>(scene.quads.size() + scene.boxes.size());
   addMaterials(scene, colours, options.texture, options.seed, used);
+  if (options.walker) {  // from a stream of its own: the room's draws stay those of walker off
+    Rng clothes(hashCombine(options.seed, 4));
+    scene.materials.push_back(makeMaterial(clothes, options.texture, Pattern::kStripes, 0.15,
+                                           hashCombine(options.seed, 1000 + used)));
+  }
   return scene;
+}
+
+Box walkerAt(double speed, double t, int material) {
+  constexpr double kReach = 1.8;  // m either side of the room's middle
+  constexpr double kY = 0.6;
+  const Eigen::Vector3d half{0.25, 0.15, 0.85};
+  // The mean of |d/dt reach sin(w t)| is 2 reach w / pi.
+  const double w = M_PI * speed / (2.0 * kReach);
+  return makeBox({kReach * std::sin(w * t), kY, half.z()}, Eigen::Matrix3d::Identity(), half,
+                 material);
 }
 
 }  // namespace acvo::synth

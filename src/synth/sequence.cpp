@@ -38,6 +38,10 @@ const SequenceOptions& validated(const SequenceOptions& o) {
     throw std::invalid_argument("vignetting must be within [-3, 0]");
   if (!(o.depth_noise_correlation >= 0 && o.depth_noise_correlation <= 50))
     throw std::invalid_argument("depth_noise_correlation must be within [0, 50] pixels");
+  if (!(o.walker_speed >= 0 && o.walker_speed <= 5))
+    throw std::invalid_argument("walker_speed must be within [0, 5] m/s");
+  if (o.walker_speed > 0 && !o.structure)
+    throw std::invalid_argument("a walker needs the furnished room (structure on)");
   return o;
 }
 
@@ -58,6 +62,7 @@ std::string describe(const SequenceOptions& o) {
   if (o.noise && o.depth_noise_correlation > 0.0) {
     s << ", depth noise correlated over " << o.depth_noise_correlation << " px";
   }
+  if (o.walker_speed > 0.0) s << ", a person walking across at " << o.walker_speed << " m/s";
   return s.str();
 }
 
@@ -120,6 +125,14 @@ Eigen::Isometry3d SynthSequence::colourPose(int i) const {
   return motion_.poseAt(i / options_.rate + options_.colour_delay);
 }
 
+Scene SynthSequence::sceneAt(double t) const {
+  if (options_.walker_speed == 0.0) return scene_;
+  Scene scene = scene_;
+  scene.boxes.push_back(walkerAt(options_.walker_speed, t,
+                                 static_cast<int>(scene.materials.size()) - 1));
+  return scene;
+}
+
 double SynthSequence::brightness(double t) const {
   if (options_.brightness_swing == 0.0) return 1.0;
   Rng rng(hashCombine(options_.seed, 11));
@@ -137,13 +150,14 @@ SynthFrame SynthSequence::frame(int i) const {
   // The frame of `pose` at time t, blurred over the shutter time centred on t.
   auto renderAt = [&](const Eigen::Isometry3d& pose, double t, std::uint64_t seed) {
     render_options.brightness = brightness(t);
+    const Scene scene = sceneAt(t);
     if (!(options_.blur && options_.blur_samples > 1 && options_.exposure > 0))
-      return render(scene_, pose, render_options, seed);
+      return render(scene, pose, render_options, seed);
     std::vector<Eigen::Isometry3d> exposure;
     const double shutter = options_.exposure / options_.rate;
     for (int k = 0; k < options_.blur_samples; ++k)
       exposure.push_back(motion_.poseAt(t + shutter * (k / (options_.blur_samples - 1.0) - 0.5)));
-    return renderBlurred(scene_, pose, exposure, render_options, seed);
+    return renderBlurred(scene, pose, exposure, render_options, seed);
   };
   const double t = i / options_.rate;
   SynthFrame f = renderAt(poses_[i], t, noise_seed);

@@ -49,10 +49,14 @@ struct SequenceOptions {
   // The depth noise's correlation length in pixels (KinectNoise::correlation_px; 0 = each
   // pixel's own).
   double depth_noise_correlation = 0.0;
+  // A person walking back and forth across the view at this speed (m/s; walkerAt in
+  // scene.hpp); 0 = none, the room standing still. A blurred frame (blur) sees the person
+  // where it stands at the frame's time: only the camera's motion blurs.
+  double walker_speed = 0.0;
   Camera camera;                // TUM default intrinsics, 640x480, depth scale 5000
   double first_stamp = 1000.0;  // seconds; frame i is at first_stamp + i / rate
 
-  SceneOptions sceneOptions() const { return {structure, texture, seed}; }
+  SceneOptions sceneOptions() const { return {structure, texture, seed, walker_speed > 0.0}; }
   MotionOptions motionOptions() const;
   RenderOptions renderOptions() const;
 };
@@ -67,7 +71,7 @@ class SynthSequence {
   // invalid camera, blur_samples < 1, exposure outside [0, 1], colour_focal_ratio outside
   // [0.5, 2], colour_baseline not within 1 m, colour_delay not under half a frame interval,
   // brightness_swing outside [0, 0.9], vignetting outside [-3, 0], depth_noise_correlation
-  // outside [0, 50]).
+  // outside [0, 50], walker_speed outside [0, 5] or with structure off).
   explicit SynthSequence(const SequenceOptions& options);
 
   int size() const { return options_.frames; }
@@ -78,7 +82,10 @@ class SynthSequence {
   // The colour's brightness factor at time t seconds after the first frame (1 unless
   // options().brightness_swing): two sines of periods 3.7 and 1.3 s, phases from the seed.
   double brightness(double t) const;
-  const Scene& scene() const { return scene_; }
+  const Scene& scene() const { return scene_; }  // the room without the walker
+  // The world at time t seconds after the first frame: scene() and, with walker_speed, the
+  // walker where it is then.
+  Scene sceneAt(double t) const;
   const Motion& motion() const { return motion_; }
   const SequenceOptions& options() const { return options_; }
 

@@ -113,6 +113,14 @@ int main(int argc, char** argv) {
       ->type_name("PX")
       ->capture_default_str()
       ->transform(acvo::tools::numberIn(0.0, 50.0, "within [0, 50] pixels"));
+  app.add_option("--walker", o.walker_speed,
+                 "a person (a box of a person's size, 1.2 m in front of the start) walking back "
+                 "and forth across the view at this speed, the scene's one moving object, as in "
+                 "TUM's dynamic sequences (a person walks at 1-1.4 m/s); 0: none. Needs "
+                 "--structure on")
+      ->type_name("M_PER_S")
+      ->capture_default_str()
+      ->transform(acvo::tools::numberIn(0.0, 5.0, "within [0, 5] m/s"));
   const auto size = acvo::tools::numberIn(8, 8192, "within [8, 8192] pixels");
   app.add_option("--width", width, "image width; the 640x480 intrinsics scale with the size")
       ->type_name("W")

@@ -453,6 +453,76 @@ TEST(SynthSequence, KnownRelativeMotionReprojectsDepth) {
   EXPECT_LT(errors[errors.size() / 2], 0.005);
 }
 
+// A walker (SequenceOptions::walker_speed) is the one thing that moves: the room without it is
+// the room of walker off, pixel for pixel, wherever the walker is not seen; where it is seen it
+// stands in front of the room; and it walks at the speed asked, across the start's view.
+TEST(SynthSequence, AWalkerMovesThroughAStillRoom) {
+  SequenceOptions o;
+  o.frames = 2;
+  o.noise = false;
+  o.seed = 61;
+  o.motion = MotionKind::kStill;
+  const SynthSequence room(o);
+  o.walker_speed = 1.0;
+  const SynthSequence walked(o);
+  EXPECT_EQ(walked.scene().boxes.size(), room.scene().boxes.size());
+  ASSERT_EQ(walked.scene().materials.size(), room.scene().materials.size() + 1);
+  for (std::size_t m = 0; m < room.scene().materials.size(); ++m) {
+    EXPECT_EQ(walked.scene().materials[m].base, room.scene().materials[m].base);
+  }
+  const int walker_first = walked.sceneAt(0.0).surfaceCount() - 6;  // its six faces
+  EXPECT_EQ(walker_first, room.scene().surfaceCount());
+
+  const SynthFrame still = room.frame(0);
+  const Eigen::Isometry3d pose = room.poses()[0];
+  const RenderOptions exact = o.renderOptions();
+  int seen = 0, elsewhere_changed = 0;
+  for (const double t : {0.0, 2.0}) {
+    const SynthFrame f = render(walked.sceneAt(t), pose, exact);
+    int walker_pixels = 0;
+    for (int v = 0; v < f.depth_m.rows; ++v) {
+      for (int u = 0; u < f.depth_m.cols; ++u) {
+        if (f.surface.at<int>(v, u) >= walker_first) {
+          ++walker_pixels;
+          EXPECT_LT(f.depth_m.at<float>(v, u), still.depth_m.at<float>(v, u) + 1e-6f);
+        } else if (f.depth_m.at<float>(v, u) != still.depth_m.at<float>(v, u) ||
+                   f.bgr.at<cv::Vec3b>(v, u) != still.bgr.at<cv::Vec3b>(v, u)) {
+          ++elsewhere_changed;
+        }
+      }
+    }
+    // In the middle of the start's view at t = 0 (measured: 37% of the image); 1.77 m to the
+    // side two seconds later at 1 m/s, out of view.
+    if (t == 0.0) {
+      EXPECT_GT(walker_pixels, int(f.depth_m.total() * 3 / 10));
+    } else {
+      EXPECT_EQ(walker_pixels, 0);
+    }
+    seen += walker_pixels;
+  }
+  EXPECT_GT(seen, 0);
+  EXPECT_EQ(elsewhere_changed, 0);
+
+  // Its mean speed over a whole back-and-forth, from its positions 1 ms apart.
+  const double period = 4 * 1.8 / o.walker_speed;
+  double path = 0.0;
+  Eigen::Vector3d last = walkerAt(o.walker_speed, 0.0, 0).box_to_world.translation();
+  for (double t = 0.001; t <= period + 1e-9; t += 0.001) {
+    const Eigen::Vector3d at = walkerAt(o.walker_speed, t, 0).box_to_world.translation();
+    path += (at - last).norm();
+    last = at;
+  }
+  EXPECT_NEAR(path / period, 1.0, 0.005);
+  EXPECT_NEAR(last.x(), 0.0, 1e-2);  // back where it started
+  EXPECT_EQ(last.z(), 0.85);         // standing on the floor
+
+  o.structure = false;  // nothing to walk through
+  EXPECT_THROW(SynthSequence{o}, std::invalid_argument);
+  o.structure = true;
+  o.walker_speed = -1.0;
+  EXPECT_THROW(SynthSequence{o}, std::invalid_argument);
+}
+
 TEST(SynthSequence, ScaledCameraKeepsTheFieldOfView) {
   const Camera full = scaledDefaultCamera(640, 480);
   EXPECT_EQ(full.fx, 525.0);

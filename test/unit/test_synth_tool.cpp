@@ -491,6 +491,8 @@ TEST(SynthTool, HelpAndBadOptions) {
   EXPECT_EQ(runTool(out + " --vignetting 0.5"), 2);
   EXPECT_EQ(runTool(out + " --depth-noise-correlation -1"), 2);
   EXPECT_EQ(runTool(out + " --depth-noise-correlation 60"), 2);
+  EXPECT_EQ(runTool(out + " --walker -1"), 2);
+  EXPECT_EQ(runTool(out + " --walker 1 --structure off"), 2);  // nothing to walk through
   EXPECT_EQ(runTool(out + " --colour red"), 2);  // unknown option
   EXPECT_FALSE(fs::exists(test::tempDir("synth_tool_bad") / "rgb.txt"));
   // A folder that cannot be created is a run-time failure, not a usage error.
