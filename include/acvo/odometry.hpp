@@ -55,6 +55,11 @@ struct OdometryResult {
   // Registered to the last tracked frame because the registration to the keyframe failed
   // (that frame became the keyframe).
   bool fell_back_to_previous = false;
+  // The registered motion missed the motion guess by more than a hand-held camera's velocity
+  // changes in a frame, so the finest level was run again from the guess (a second start,
+  // OdometryParams::second_start), and whether that result was kept.
+  bool second_start = false;
+  bool second_start_kept = false;
   std::shared_ptr<const LabelledCloud> cloud;  // this frame's cloud (null for a bad frame)
   SolverResult solver;                         // the registration that decided this frame
   std::size_t fixed_points = 0;                // points of the cloud registered to
@@ -84,6 +89,22 @@ struct OdometryResult {
   bool colour_verdict_now = false;
   bool colour_resampled = false;
 };
+
+// A registered motion that misses the motion guess by more than this in one frame gets a second
+// start (OdometryParams::second_start): a velocity change of 0.6 m/s or 90 deg/s within a frame
+// at 30 Hz. The guess missed the registered motion by up to 15 mm and 1.5 deg on teddy200, 20 mm
+// and 1.4 deg on kitchen7s_dev, 34 mm on a rendered room at 0.8 m/s (its first frame, whose guess
+// knows no velocity yet), 60-140 mm where a person crossing at 1 m/s had pulled the
+// registration along: the thresholds decide where the second start is paid for.
+inline constexpr double kSecondStartTranslation = 0.02;  // m
+inline constexpr double kSecondStartRotation = 3.0;      // deg
+// The second start, from the guess, is kept unless the first's kernel value at the finest level
+// is more than this times its own: of two maxima of the objective the one the camera's own
+// motion predicts, unless the other clearly scores higher. Where a person covers half the view
+// the two score alike (measured 17.8 and 17.4; a person's mode 1.05-1.4x the room's); where the
+// camera itself jerked the second start scores 5-8x lower (the first frames of two rendered rooms
+// at 0.6 and 0.8 m/s). 1.1 and 1.3 measured the same as 1.2 (docs/accuracy.md, eighteenth round).
+inline constexpr double kSecondStartMargin = 1.2;
 
 // Tracking judgement of a registration, from the solver's result and the motion it implies
 // from the last tracked frame (`frame_motion`; the registration's own transform when the frame
@@ -141,6 +162,10 @@ bool replacesReference(const SolverResult& s, std::size_t points, std::size_t re
 //    from it composed with the motion prior; when that fails (lost), to the last tracked frame,
 //    which then becomes the keyframe. A frame that is lost keeps the last good pose (its
 //    covariance grows with lostGrowth) and drops the motion prior.
+//  - either: a registration whose motion misses the prior by more than kSecondStartTranslation
+//    or kSecondStartRotation is run again at the finest level from the prior, and that second
+//    start is kept unless the first's kernel value there is kSecondStartMargin times higher
+//    (OdometryParams::second_start).
 class Odometry {
  public:
   explicit Odometry(const Params& params = Params());
@@ -227,6 +252,11 @@ class Odometry {
   // instant than the colour (retimes), in two stages with the depth moved again in between.
   Registration registerTo(const Tracked& reference, const std::shared_ptr<PreparedCloud>& current,
                           const Eigen::Isometry3d& guess, const Frame& frame, OdometryResult& r);
+  // Where reg's motion missed `guess` (OdometryParams::second_start, kSecondStartTranslation),
+  // the finest level again from the guess, kept unless the first scores kSecondStartMargin
+  // times higher.
+  void secondStart(const Tracked& reference, const Eigen::Isometry3d& guess, Registration& reg,
+                   OdometryResult& r);
   // Whether registrations of this frame move its depth again (sync_depth, a delay, a staged
   // engine).
   bool retimes(const OdometryResult& r) const;

@@ -184,6 +184,15 @@ struct OdometryParams {
   // colour and depth come from free-running streams through real lenses (docs/accuracy.md,
   // fifteenth round). On: for two synchronised cameras known to be pinholes (a simulator's).
   bool resample_colour_baseline = false;
+  // Where the registered motion misses the motion guess (constant velocity) by more than
+  // kSecondStartTranslation or kSecondStartRotation in one frame (odometry.hpp; more than a
+  // hand-held camera's velocity changes in a frame: up to 20 mm on the real folders), the
+  // finest level is run again from the guess, and that result is kept unless the first's kernel
+  // value there is kSecondStartMargin times higher. A person crossing a third of the view can
+  // pull the coarse levels, whose kernel spans both motions, into the person's motion; the
+  // finest level's narrow kernel, started from the camera's own predicted motion, holds the
+  // still part (docs/accuracy.md, eighteenth round). Off: the paper's single start.
+  bool second_start = true;
 };
 
 struct Params {
@@ -284,6 +293,7 @@ void visitParams(Params_& p, Visitor&& visit) {
   visit("odometry", "sync_depth", p.odometry.sync_depth);
   visit("odometry", "resample_unregistered_colour", p.odometry.resample_unregistered_colour);
   visit("odometry", "resample_colour_baseline", p.odometry.resample_colour_baseline);
+  visit("odometry", "second_start", p.odometry.second_start);
 }
 
 // The paper's A-CVO as the authors' code runs it (config/paper.yaml; docs/method.md §4 says

@@ -242,6 +242,7 @@ Params paperParams() {
   p.odometry.hard_matched_fraction = 0.05;
   p.odometry.sync_depth = false;  // colour and depth paired as they come
   p.odometry.resample_unregistered_colour = false;  // and the colour used as it comes
+  p.odometry.second_start = false;                  // one registration per frame
   return p;
 }
 

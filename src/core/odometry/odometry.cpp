@@ -248,6 +248,7 @@ Odometry::Registration Odometry::registerTo(const Tracked& reference,
         coarse, engine_->align(*reference.cloud, *reg.moving, coarse.transform,
                                AlignStages::kFinest));
   });
+  if (params_.odometry.second_start) secondStart(reference, guess, reg, r);
   reg.judgement = judgeTracking(reg.solver, frameMotion(reg.solver.transform), params_.odometry);
   const SolverResult& s = reg.solver;
   if (s.status == SolverStatus::kTooFewPoints || s.status == SolverStatus::kNotFinite) {
@@ -480,6 +481,34 @@ void Odometry::start(OdometryResult& r, const std::shared_ptr<PreparedCloud>& cu
   r.tracking = Tracking::kFirstFrame;
   r.keyframe_index = r.frame_index;
   r.new_keyframe = true;
+}
+
+void Odometry::secondStart(const Tracked& reference, const Eigen::Isometry3d& guess,
+                           Registration& reg, OdometryResult& r) {
+  const SolverStatus status = reg.solver.status;
+  if (status == SolverStatus::kTooFewPoints || status == SolverStatus::kNotFinite) return;
+  // Both transforms map into the reference: guess^-1 T is the registered frame motion against
+  // the guessed one, from any reference.
+  const Eigen::Isometry3d missed = guess.inverse() * reg.solver.transform;
+  if (missed.translation().norm() <= kSecondStartTranslation &&
+      rotationDeg(missed) <= kSecondStartRotation) {
+    return;
+  }
+  r.second_start = true;
+  SolverResult again;
+  arena_->arena.execute(
+      [&] { again = engine_->align(*reference.cloud, *reg.moving, guess, AlignStages::kFinest); });
+  reg.solver.ms_total += again.ms_total;
+  reg.solver.ms_neighbours += again.ms_neighbours;
+  if (again.status == SolverStatus::kTooFewPoints || again.status == SolverStatus::kNotFinite ||
+      !(kSecondStartMargin * again.objective > reg.solver.objective)) {
+    return;
+  }
+  r.second_start_kept = true;
+  again.iterations += reg.solver.iterations;
+  again.ms_total = reg.solver.ms_total;
+  again.ms_neighbours = reg.solver.ms_neighbours;
+  reg.solver = std::move(again);
 }
 
 Odometry::Registration Odometry::registerFrame(OdometryResult& r, const Frame& frame,
