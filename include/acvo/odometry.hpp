@@ -95,15 +95,20 @@ struct OdometryResult {
 // at 30 Hz. The guess missed the registered motion by up to 15 mm and 1.5 deg on teddy200, 20 mm
 // and 1.4 deg on kitchen7s_dev, 34 mm on a rendered room at 0.8 m/s (its first frame, whose guess
 // knows no velocity yet), 60-140 mm where a person crossing at 1 m/s had pulled the
-// registration along: the thresholds decide where the second start is paid for.
+// registration along. Over a longer interval t the limits grow by (t / kSecondStartInterval)^2,
+// as the miss of a camera's own acceleration does (every 4th frame of teddy200 with fixed limits:
+// 0.0047 / 0.485 -> 0.0058 / 0.559, the second start kept where the camera's own motion
+// changed).
 inline constexpr double kSecondStartTranslation = 0.02;  // m
 inline constexpr double kSecondStartRotation = 3.0;      // deg
+inline constexpr double kSecondStartInterval = 1.0 / 30.0;  // s
 // The second start, from the guess, is kept unless the first's kernel value at the finest level
 // is more than this times its own: of two maxima of the objective the one the camera's own
 // motion predicts, unless the other clearly scores higher. Where a person covers half the view
-// the two score alike (measured 17.8 and 17.4; a person's mode 1.05-1.4x the room's); where the
-// camera itself jerked the second start scores 5-8x lower (the first frames of two rendered rooms
-// at 0.6 and 0.8 m/s). 1.1 and 1.3 measured the same as 1.2 (docs/accuracy.md, eighteenth round).
+// the two score alike (measured 17.8 and 17.4, 14.4 and 13.8, the person's mode the higher);
+// where the camera itself jerked the second start scores 5-8x lower (the first frames of two
+// rendered rooms at 0.6 and 0.8 m/s). 1.1 and 1.3 measured the same as 1.2 (docs/accuracy.md,
+// eighteenth round).
 inline constexpr double kSecondStartMargin = 1.2;
 
 // Tracking judgement of a registration, from the solver's result and the motion it implies

@@ -490,8 +490,11 @@ void Odometry::secondStart(const Tracked& reference, const Eigen::Isometry3d& gu
   // Both transforms map into the reference: guess^-1 T is the registered frame motion against
   // the guessed one, from any reference.
   const Eigen::Isometry3d missed = guess.inverse() * reg.solver.transform;
-  if (missed.translation().norm() <= kSecondStartTranslation &&
-      rotationDeg(missed) <= kSecondStartRotation) {
+  // A velocity change misses by its acceleration times the interval squared.
+  const double frames = r.interval / kSecondStartInterval;
+  const double scale = std::max(1.0, frames * frames);
+  if (missed.translation().norm() <= scale * kSecondStartTranslation &&
+      rotationDeg(missed) <= scale * kSecondStartRotation) {
     return;
   }
   r.second_start = true;
