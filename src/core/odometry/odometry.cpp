@@ -97,6 +97,11 @@ Eigen::Isometry3d atConstantVelocity(const Eigen::Isometry3d& motion, double mea
 double rotationDeg(const Eigen::Isometry3d& T) {
   return logSE3(T).head<3>().norm() * 180.0 / M_PI;
 }
+
+// The solver gave no registration: too few points, or numbers that are not finite.
+bool failed(SolverStatus status) {
+  return status == SolverStatus::kTooFewPoints || status == SolverStatus::kNotFinite;
+}
 }  // namespace
 
 Frame depthAsRegistered(const Frame& frame, const OdometryResult& r) {
@@ -110,7 +115,7 @@ Judgement judgeTracking(const SolverResult& s, const Eigen::Isometry3d& frame_mo
                         const OdometryParams& params) {
   const double rotation_deg = rotationDeg(frame_motion);
   const double translation = frame_motion.translation().norm();
-  if (s.status == SolverStatus::kTooFewPoints || s.status == SolverStatus::kNotFinite) {
+  if (failed(s.status)) {
     return {Tracking::kLost, "registration failed: " + toString(s.status)};
   }
   if (s.matched_fraction < params.lost_matched_fraction) {
@@ -165,10 +170,8 @@ bool replacesReference(const SolverResult& s, std::size_t points, std::size_t re
   // Measured (previous_frame): re-seeding from a frame of noise (matched 0) cost the motion of
   // two frames; frames lost narrowly (kitchen7s_dev with the fixed schedule) do re-seed: the
   // next frame registered against the older reference was lost more often (15 frames, not 13).
-  const bool failed =
-      s.status == SolverStatus::kTooFewPoints || s.status == SolverStatus::kNotFinite;
   const bool unrelated =
-      !failed && s.matched_fraction < 0.2 * params.odometry.lost_matched_fraction;
+      !failed(s.status) && s.matched_fraction < 0.2 * params.odometry.lost_matched_fraction;
   return lost_in_a_row >= 2 || !unrelated;
 }
 
@@ -230,7 +233,7 @@ Odometry::Registration Odometry::registerTo(const Tracked& reference,
     // by that.
     const SolverResult coarse =
         engine_->align(*reference.cloud, *current, guess, AlignStages::kCoarse);
-    if (coarse.status == SolverStatus::kTooFewPoints || coarse.status == SolverStatus::kNotFinite) {
+    if (failed(coarse.status)) {
       reg.solver = coarse;
       return;
     }
@@ -251,7 +254,7 @@ Odometry::Registration Odometry::registerTo(const Tracked& reference,
   if (params_.odometry.second_start) secondStart(reference, guess, reg, r);
   reg.judgement = judgeTracking(reg.solver, frameMotion(reg.solver.transform), params_.odometry);
   const SolverResult& s = reg.solver;
-  if (s.status == SolverStatus::kTooFewPoints || s.status == SolverStatus::kNotFinite) {
+  if (failed(s.status)) {
     reg.judgement.message += " (" + std::to_string(reg.fixed_points) + " and " +
                              std::to_string(reg.moving->size()) + " points)";
   }
@@ -485,8 +488,7 @@ void Odometry::start(OdometryResult& r, const std::shared_ptr<PreparedCloud>& cu
 
 void Odometry::secondStart(const Tracked& reference, const Eigen::Isometry3d& guess,
                            Registration& reg, OdometryResult& r) {
-  const SolverStatus status = reg.solver.status;
-  if (status == SolverStatus::kTooFewPoints || status == SolverStatus::kNotFinite) return;
+  if (failed(reg.solver.status)) return;
   // Both transforms map into the reference: guess^-1 T is the registered frame motion against
   // the guessed one, from any reference.
   const Eigen::Isometry3d missed = guess.inverse() * reg.solver.transform;
@@ -503,8 +505,7 @@ void Odometry::secondStart(const Tracked& reference, const Eigen::Isometry3d& gu
       [&] { again = engine_->align(*reference.cloud, *reg.moving, guess, AlignStages::kFinest); });
   reg.solver.ms_total += again.ms_total;
   reg.solver.ms_neighbours += again.ms_neighbours;
-  if (again.status == SolverStatus::kTooFewPoints || again.status == SolverStatus::kNotFinite ||
-      !(kSecondStartMargin * again.objective > reg.solver.objective)) {
+  if (failed(again.status) || !(kSecondStartMargin * again.objective > reg.solver.objective)) {
     return;
   }
   r.second_start_kept = true;
