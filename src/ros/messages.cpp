@@ -73,6 +73,8 @@ acvo::OdometryInfo toInfoMsg(const acvo::OdometryResult& result, const std_msgs:
   info.fell_back_to_previous = result.fell_back_to_previous;
   info.interval = result.interval;
   info.guess_from_tf = extras.guess_from_tf;
+  info.second_start = result.second_start;
+  info.second_start_kept = result.second_start_kept;
   info.ms_cloud = result.ms_cloud;
   info.ms_registration = result.ms_registration;
   info.ms_total = extras.ms_total;

@@ -665,6 +665,7 @@ TEST(InfoMsg, CarriesTheResult) {
   r.new_keyframe = true;
   r.fell_back_to_previous = true;
   r.interval = 0.066;
+  r.second_start = true;
   InfoExtras extras;
   extras.ms_total = 12.5;
   extras.ms_latency = 40.25;
@@ -687,6 +688,8 @@ TEST(InfoMsg, CarriesTheResult) {
   EXPECT_TRUE(info.new_keyframe);
   EXPECT_TRUE(info.fell_back_to_previous);
   EXPECT_EQ(info.interval, 0.066);
+  EXPECT_TRUE(info.second_start);
+  EXPECT_FALSE(info.second_start_kept);
 }
 
 // The dense depth term: its weight, or why it is off.

@@ -503,13 +503,15 @@ void Odometry::secondStart(const Tracked& reference, const Eigen::Isometry3d& gu
   SolverResult again;
   arena_->arena.execute(
       [&] { again = engine_->align(*reference.cloud, *reg.moving, guess, AlignStages::kFinest); });
+  // The frame's cost is both starts', whichever is kept.
   reg.solver.ms_total += again.ms_total;
   reg.solver.ms_neighbours += again.ms_neighbours;
+  reg.solver.iterations += again.iterations;
   if (failed(again.status) || !(kSecondStartMargin * again.objective > reg.solver.objective)) {
     return;
   }
   r.second_start_kept = true;
-  again.iterations += reg.solver.iterations;
+  again.iterations = reg.solver.iterations;
   again.ms_total = reg.solver.ms_total;
   again.ms_neighbours = reg.solver.ms_neighbours;
   reg.solver = std::move(again);
