@@ -23,6 +23,17 @@ synth::SynthSequence exactSequence(int frames) {
   return synth::SynthSequence(o);
 }
 
+// Six exact 320x240 frames at 0.5 m/s whose colour is taken 12 ms after their depth.
+synth::SynthSequence lateColourSequence() {
+  synth::SequenceOptions o;
+  o.frames = 6;
+  o.noise = false;
+  o.speed = 0.5;
+  o.colour_delay = 0.012;
+  o.camera = synth::scaledDefaultCamera(320, 240);
+  return synth::SynthSequence(o);
+}
+
 double median(std::vector<double> v) {
   std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(v.size() / 2), v.end());
   return v[v.size() / 2];
@@ -185,13 +196,7 @@ TEST(Odometry, MotionPriorAcrossAStampGapIsOneFramesMotion) {
 // stages (OdometryResult::depth_retimed), and their points land within a fraction of what the
 // depth as it came puts them off by.
 TEST(Odometry, DepthOfAnotherInstantIsMovedByTheFramesOwnMotion) {
-  synth::SequenceOptions o;
-  o.frames = 6;
-  o.noise = false;
-  o.speed = 0.5;
-  o.colour_delay = 0.012;
-  o.camera = synth::scaledDefaultCamera(320, 240);
-  const synth::SynthSequence seq(o);
+  const synth::SynthSequence seq = lateColourSequence();
   for (const bool sync : {true, false}) {
     Params params;
     params.odometry.sync_depth = sync;
@@ -247,6 +252,79 @@ TEST(Odometry, DepthOfAnotherInstantIsMovedByTheFramesOwnMotion) {
     const OdometryResult r = odo.process(same.frame(i).toFrame());
     EXPECT_FALSE(r.depth_synced || r.depth_retimed);
     EXPECT_TRUE(r.own_velocity_weight.hasNaN());
+  }
+}
+
+// selection.reference_density 2: each frame registers half of its selection, and a frame that
+// becomes a keyframe keeps all of it, with its depth moved to the colour's instant as the
+// registered half's was.
+TEST(Odometry, ADenserReferenceKeepsTheWholeSelectionOfItsKeyframes) {
+  const synth::SynthSequence seq = lateColourSequence();
+  for (const Reference reference : {Reference::kKeyframe, Reference::kPreviousFrame}) {
+    Params params;
+    params.selection.reference_density = 2.0;
+    params.odometry.reference = reference;
+    params.odometry.keyframe_translation = 0.01;  // 17 mm a frame: a keyframe every frame
+    Odometry odo(params);
+    odo.reset(seq.colourPose(0));
+    Params as_selected = params;
+    as_selected.selection.reference_density = 1.0;
+    Odometry plain(as_selected);
+    plain.reset(seq.colourPose(0));
+    std::size_t last_keyframe_size = 0;
+    double error = 0.0, plain_error = 0.0;
+    for (int i = 0; i < seq.size(); ++i) {
+      const Frame frame = seq.frame(i).toFrame();
+      const OdometryResult r = odo.process(frame);
+      const OdometryResult p = plain.process(frame);
+      ASSERT_TRUE(r.tracking == Tracking::kOk || (i == 0 && r.tracking == Tracking::kFirstFrame))
+          << toString(r.tracking) << ": " << r.message;
+      ASSERT_TRUE(r.new_keyframe) << "frame " << i;
+      ASSERT_NE(odo.keyframeCloud(), nullptr);
+      const LabelledCloud& keyframe = *odo.keyframeCloud();
+      // Half the selection registered, the whole of it the reference (a point of the selection
+      // without depth at the colour's instant is dropped from either).
+      const double ratio = double(keyframe.size()) / double(r.moving_points);
+      EXPECT_NEAR(ratio, 2.0, 0.05) << "frame " << i;
+      EXPECT_NEAR(double(r.moving_points), double(p.moving_points), 0.1 * p.moving_points);
+      EXPECT_EQ(r.depth_retimed, i >= 1) << "frame " << i;
+      // Registered to the last frame's whole selection.
+      if (i > 0) {
+        EXPECT_EQ(r.fixed_points, last_keyframe_size) << "frame " << i;
+      }
+      last_keyframe_size = keyframe.size();
+      if (i == 0) continue;
+      const Eigen::Isometry3d true_motion = seq.colourPose(i - 1).inverse() * seq.colourPose(i);
+      error += translationError(true_motion, r.motion);
+      plain_error += translationError(true_motion, p.motion);
+      // The keyframe's points come from the depth moved to the colour's instant: the median
+      // error against the exact depth there as small as the registered cloud's.
+      const Eigen::Isometry3d to_colour = seq.poses()[std::size_t(i)].inverse() * seq.colourPose(i);
+      const cv::Mat truth = depthSeenFrom(frame.depth, frame.camera, to_colour);
+      const auto medianError = [&truth](const LabelledCloud& c) {
+        std::vector<double> e;
+        for (std::size_t k = 0; k < c.size(); ++k) {
+          const float z = truth.at<float>(c.pixels[k]);
+          if (z > 0.f) e.push_back(std::abs(c.points[k].z() - z));
+        }
+        return median(e);
+      };
+      const double as_it_came = [&] {
+        std::vector<double> e;
+        for (const cv::Point& px : keyframe.pixels) {
+          const float z = truth.at<float>(px), z0 = frame.depth.at<float>(px);
+          if (z > 0.f && z0 > 0.f) e.push_back(std::abs(z0 - z));
+        }
+        return median(e);
+      }();
+      EXPECT_LT(medianError(keyframe), 0.3 * as_it_came) << "frame " << i;
+      EXPECT_LT(medianError(keyframe), 2.0 * medianError(*r.cloud) + 1e-5) << "frame " << i;
+    }
+    // No worse than every cloud as selected, on the same frames (measured: 11.4 mm against
+    // 17.4 mm over the five motions; at 0.5 m/s with the colour 12 ms late, neither is exact).
+    std::printf("  reference %s: summed motion error %.2f mm, as selected %.2f mm\n",
+                toString(reference).c_str(), 1e3 * error, 1e3 * plain_error);
+    EXPECT_LT(error, plain_error);
   }
 }
 

@@ -3,6 +3,7 @@
 #include "acvo/labelled_cloud.hpp"
 
 #include <chrono>
+#include <cmath>
 #include <stdexcept>
 
 #include <opencv2/imgproc.hpp>
@@ -111,6 +112,29 @@ LabelledCloud withDepth(const LabelledCloud& cloud, const cv::Mat& depth_m,
     out.points.emplace_back(cloud.camera.backProject(p.x, p.y, z).cast<float>());
     out.labels.push_back(cloud.labels[i]);
     out.pixels.push_back(p);
+    out.rgb.push_back(cloud.rgb[i]);
+  }
+  return out;
+}
+
+LabelledCloud everyNth(const LabelledCloud& cloud, double step) {
+  if (!(step >= 1.0)) throw std::invalid_argument("everyNth: the step must be at least 1");
+  LabelledCloud out = cloud;
+  out.points.clear();
+  out.labels.clear();
+  out.pixels.clear();
+  out.rgb.clear();
+  const auto count = std::size_t(std::ceil(double(cloud.size()) / step));
+  out.points.reserve(count);
+  out.labels.reserve(count);
+  out.pixels.reserve(count);
+  out.rgb.reserve(count);
+  for (std::size_t k = 0;; ++k) {
+    const auto i = std::size_t(std::floor(double(k) * step));
+    if (i >= cloud.size()) break;
+    out.points.push_back(cloud.points[i]);
+    out.labels.push_back(cloud.labels[i]);
+    out.pixels.push_back(cloud.pixels[i]);
     out.rgb.push_back(cloud.rgb[i]);
   }
   return out;

@@ -31,6 +31,7 @@ struct Odometry::Registration {
   // This frame's velocity (twist per second) as the coarse levels found it, where the
   // registration ran in two stages.
   std::optional<Vector6d> coarse_velocity;
+  cv::Mat moved_depth;  // the depth `moving` took its points from, where moved again
   SolverResult solver;
   Judgement judgement;
   Matrix6d covariance = lostCovariance();  // of the motion, when tracked
@@ -246,7 +247,9 @@ Odometry::Registration Odometry::registerTo(const Tracked& reference,
     r.own_velocity_weight = {gain.diagonal().head<3>().mean(), gain.diagonal().tail<3>().mean()};
     const Vector6d velocity =
         last ? VelocityFilter::blend(gain, *last, *reg.coarse_velocity) : *reg.coarse_velocity;
-    if (auto again = retimedCloud(*current, frame, velocity, r)) reg.moving = std::move(again);
+    if (auto again = retimedCloud(*current, frame, velocity, r, &reg.moved_depth)) {
+      reg.moving = std::move(again);
+    }
     reg.solver = combinedStages(
         coarse, engine_->align(*reference.cloud, *reg.moving, coarse.transform,
                                AlignStages::kFinest));
@@ -300,8 +303,7 @@ void Odometry::checkColour(const Frame& frame, OdometryResult& r) {
   // with where it was not (measured: 59 mm off on such a frame of a rendered room).
   OdometryResult again;
   const std::shared_ptr<PreparedCloud> cloud =
-      buildCloud(resampled(frame), again);
-  asReference(again, *cloud);
+      asReferenceCloud(again, buildCloud(resampled(frame), again));
   Tracked rebuilt = *last_;
   rebuilt.cloud = cloud;
   rebuilt.to_keyframe = Eigen::Isometry3d::Identity();
@@ -432,7 +434,7 @@ bool Odometry::retimes(const OdometryResult& r) const {
 std::shared_ptr<PreparedCloud> Odometry::retimedCloud(const PreparedCloud& current,
                                                       const Frame& frame,
                                                       const Vector6d& velocity,
-                                                      OdometryResult& r) const {
+                                                      OdometryResult& r, cv::Mat* depth) const {
   const auto t0 = std::chrono::steady_clock::now();
   // What the cloud was built with: the last frame-to-frame motion over the delay, or nothing.
   const Eigen::Isometry3d before =
@@ -445,8 +447,8 @@ std::shared_ptr<PreparedCloud> Odometry::retimedCloud(const PreparedCloud& curre
   }
   // The pixels stay those selected: the colour image has not changed, only where the depth
   // puts their points.
-  LabelledCloud cloud =
-      withDepth(current.cloud, depthSeenFrom(frame.depth, frame.camera, moved), params_.selection);
+  *depth = depthSeenFrom(frame.depth, frame.camera, moved);
+  LabelledCloud cloud = withDepth(current.cloud, *depth, params_.selection);
   auto out = engine_->prepare(std::move(cloud), current.reference);
   r.ms_cloud += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
                     .count();
@@ -461,13 +463,24 @@ std::shared_ptr<PreparedCloud> Odometry::buildCloud(const Frame& frame, Odometry
   // With keyframes, only when it becomes one (asReference).
   const bool every_frame_a_reference = params_.odometry.reference == Reference::kPreviousFrame;
   const Frame at_colour_time = depthAtColourTime(frame, r);
+  const double density = params_.selection.reference_density;
+  selected_.reset();
   arena_->arena.execute([&] {
-    LabelledCloud cloud = buildLabelledCloud(at_colour_time, params_.selection, &r.cloud_stats);
+    SelectionParams selection = params_.selection;
+    if (density > 1.0) {
+      selection.target_points = int(std::lround(selection.target_points * density));
+    }
+    LabelledCloud cloud = buildLabelledCloud(at_colour_time, selection, &r.cloud_stats);
     // The motion while the shutter was open.
     if (const double exposure = params_.coarse_to_fine.exposure_time; exposure > 0.0) {
       cloud.blur_motion = motionOver(exposure).value_or(Eigen::Isometry3d::Identity());
     }
-    current = engine_->prepare(std::move(cloud), every_frame_a_reference);
+    if (density > 1.0) {
+      selected_ = cloud;
+      cloud = everyNth(cloud, density);
+    }
+    // A share's search grids would not be used: the whole selection becomes the reference.
+    current = engine_->prepare(std::move(cloud), every_frame_a_reference && !selected_);
   });
   r.ms_cloud = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
   r.moving_points = current->size();
@@ -476,9 +489,27 @@ std::shared_ptr<PreparedCloud> Odometry::buildCloud(const Frame& frame, Odometry
   return current;
 }
 
-void Odometry::start(OdometryResult& r, const std::shared_ptr<PreparedCloud>& current) {
+std::shared_ptr<PreparedCloud> Odometry::asReferenceCloud(
+    OdometryResult& r, const std::shared_ptr<PreparedCloud>& registered, const cv::Mat& depth) {
+  std::shared_ptr<PreparedCloud> cloud = registered;
+  if (selected_) {
+    const auto t0 = std::chrono::steady_clock::now();
+    LabelledCloud all = depth.empty() ? std::move(*selected_)
+                                      : withDepth(*selected_, depth, params_.selection);
+    selected_.reset();
+    arena_->arena.execute([&] { cloud = engine_->prepare(std::move(all), false); });
+    const double ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    r.ms_prepare += ms;
+    r.ms_cloud += ms;
+  }
+  asReference(r, *cloud);
+  return cloud;
+}
+
+void Odometry::start(OdometryResult& r, const std::shared_ptr<PreparedCloud>& registered) {
   lost_in_a_row_ = 0;
-  asReference(r, *current);
+  const std::shared_ptr<PreparedCloud> current = asReferenceCloud(r, registered);
   keyframe_ = last_ =
       Tracked{current, r.frame_index, pose_, pose_covariance_, Eigen::Isometry3d::Identity()};
   r.tracking = Tracking::kFirstFrame;
@@ -581,7 +612,7 @@ void Odometry::tracked(OdometryResult& r, const Registration& reg,
       takesKeyframe(reg.judgement, reg.solver, params_.odometry)) {
     frame.to_keyframe = Eigen::Isometry3d::Identity();
     frame.to_keyframe_covariance = Matrix6d::Zero();
-    asReference(r, *current);
+    frame.cloud = asReferenceCloud(r, current, reg.moved_depth);
     keyframe_ = frame;
     r.new_keyframe = true;
   }
@@ -602,9 +633,8 @@ void Odometry::lost(OdometryResult& r, const Registration& reg,
                         params_)) {
     // The held pose with what it may be wrong by: the next frames are registered from here.
     pose_covariance_ = r.pose_covariance;
-    asReference(r, *current);
-    keyframe_ = last_ =
-        Tracked{current, r.frame_index, pose_, pose_covariance_, Eigen::Isometry3d::Identity()};
+    keyframe_ = last_ = Tracked{asReferenceCloud(r, current), r.frame_index, pose_,
+                                pose_covariance_, Eigen::Isometry3d::Identity()};
     r.new_keyframe = true;
   }
 }
