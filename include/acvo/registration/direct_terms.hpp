@@ -13,7 +13,8 @@
 // Each term learns the scale s of its residuals from them at every iteration (1.4826 times their
 // median absolute value, a photometric residual counted by its squared gradient), gives each the
 // variance s^2 (plus, for a grey value, its gradient squared times the 1/12 px^2 to which an
-// edge's position is known) and Huber's weight beyond 2 standard deviations.
+// edge's position is known) and Tukey's biweight to 8 standard deviations: a residual beyond
+// them (a person crossing the view) no longer pulls.
 #pragma once
 
 #include <cmath>
