@@ -86,24 +86,33 @@ LabelledCloud buildLabelledCloud(const Frame& frame, const SelectionParams& para
   return cloud;
 }
 
-LabelledCloud withDepth(const LabelledCloud& cloud, const cv::Mat& depth_m,
-                        const SelectionParams& params) {
-  if (depth_m.type() != CV_32FC1 || depth_m.cols != cloud.width || depth_m.rows != cloud.height) {
-    throw std::invalid_argument("withDepth: expects CV_32FC1 metres of the cloud's image size");
-  }
+namespace {
+// A cloud with `cloud`'s images, camera, stamp and motions and room for `count` points, none yet.
+LabelledCloud withoutPoints(const LabelledCloud& cloud, std::size_t count) {
   LabelledCloud out;
   out.stamp = cloud.stamp;
   out.depth_of_another_instant = cloud.depth_of_another_instant;
   out.width = cloud.width;
   out.height = cloud.height;
   out.gray = cloud.gray;
-  out.depth = depth_m;
+  out.depth = cloud.depth;
   out.camera = cloud.camera;
   out.blur_motion = cloud.blur_motion;
-  out.points.reserve(cloud.size());
-  out.labels.reserve(cloud.size());
-  out.pixels.reserve(cloud.size());
-  out.rgb.reserve(cloud.size());
+  out.points.reserve(count);
+  out.labels.reserve(count);
+  out.pixels.reserve(count);
+  out.rgb.reserve(count);
+  return out;
+}
+}  // namespace
+
+LabelledCloud withDepth(const LabelledCloud& cloud, const cv::Mat& depth_m,
+                        const SelectionParams& params) {
+  if (depth_m.type() != CV_32FC1 || depth_m.cols != cloud.width || depth_m.rows != cloud.height) {
+    throw std::invalid_argument("withDepth: expects CV_32FC1 metres of the cloud's image size");
+  }
+  LabelledCloud out = withoutPoints(cloud, cloud.size());
+  out.depth = depth_m;
   const SelectableDepth selectable(params);
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     const cv::Point& p = cloud.pixels[i];
@@ -119,16 +128,8 @@ LabelledCloud withDepth(const LabelledCloud& cloud, const cv::Mat& depth_m,
 
 LabelledCloud everyNth(const LabelledCloud& cloud, double step) {
   if (!(step >= 1.0)) throw std::invalid_argument("everyNth: the step must be at least 1");
-  LabelledCloud out = cloud;
-  out.points.clear();
-  out.labels.clear();
-  out.pixels.clear();
-  out.rgb.clear();
-  const auto count = std::size_t(std::ceil(double(cloud.size()) / step));
-  out.points.reserve(count);
-  out.labels.reserve(count);
-  out.pixels.reserve(count);
-  out.rgb.reserve(count);
+  LabelledCloud out =
+      withoutPoints(cloud, std::size_t(std::ceil(double(cloud.size()) / step)));
   for (std::size_t k = 0;; ++k) {
     const auto i = std::size_t(std::floor(double(k) * step));
     if (i >= cloud.size()) break;

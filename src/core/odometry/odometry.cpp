@@ -476,8 +476,8 @@ std::shared_ptr<PreparedCloud> Odometry::buildCloud(const Frame& frame, Odometry
       cloud.blur_motion = motionOver(exposure).value_or(Eigen::Isometry3d::Identity());
     }
     if (density > 1.0) {
-      selected_ = cloud;
-      cloud = everyNth(cloud, density);
+      selected_ = std::move(cloud);
+      cloud = everyNth(*selected_, density);
     }
     // A share's search grids would not be used: the whole selection becomes the reference.
     current = engine_->prepare(std::move(cloud), every_frame_a_reference && !selected_);
