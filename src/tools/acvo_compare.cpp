@@ -48,6 +48,8 @@ turn; times cover the odometry call only (acvo: cloud building and registration;
 conversion, hole marking, pyramids and registration).
 --stride K keeps every K-th frame: the same camera moving K times faster between frames, the
 way to see how wide each method's basin is (the dataset is then named <folder>_everyK).
+--camera gives every method other intrinsics than the folder's camera.yaml: a calibration of
+one's own, or a focal length a few percent off to see how much each method depends on it.
 )";
 
 constexpr const char* kFooter = "Exit status: 0 success, 2 bad arguments or input.";
@@ -56,7 +58,7 @@ struct Options {
   std::vector<std::string> datasets, methods{"acvo", "rgbd", "icp", "rgbd_icp"}, sets;
   std::vector<double> peer_max_depth{4.0, 10.0};
   std::vector<int> threads{1};
-  std::string config, label = "acvo", json, trajectories;
+  std::string config, label = "acvo", json, trajectories, camera;
   long frames = -1, stride = 1;
   int repeat = 1;
   bool peer_guess = false;
@@ -95,6 +97,10 @@ std::optional<int> parseOptions(CLI::App& app, Options& o, int argc, char** argv
   app.add_flag("--peer-guess", o.peer_guess,
                "give the OpenCV odometries the last motion as the initial guess (OpenCV's "
                "sample gives none)");
+  app.add_option("--camera", o.camera,
+                 "every method's intrinsics, and a lens distortion the frames are undistorted by "
+                 "(default: each DATASET_DIR/camera.yaml, else default)")
+      ->type_name("FILE|fr1|fr2|fr3|default");
   app.add_option("--config", o.config, "acvo parameters (default: built in, as config/acvo.yaml)")
       ->type_name("FILE");
   app.add_option("--set", o.sets, "override one acvo parameter (repeatable)")
@@ -359,8 +365,9 @@ void printTable(const std::vector<Row>& rows, const Options& opt) {
   for (int t : opt.threads) threads += (threads.empty() ? "" : ",") + threadsSetting(t);
   std::printf("# acvo on %s; OpenCV odometries serial, as OpenCV's TUM sample runs them (NaN "
               "holes, no guess); times: median over frames, median of %d run%s interleaved "
-              "frame by frame; vs_rgbd: median time / the best RgbdOdometry setting's, per run\n",
-              threads.c_str(), opt.repeat, opt.repeat == 1 ? "" : "s");
+              "frame by frame; vs_rgbd: median time / the best RgbdOdometry setting's, per run%s\n",
+              threads.c_str(), opt.repeat, opt.repeat == 1 ? "" : "s",
+              opt.camera.empty() ? "" : ("; camera: " + opt.camera).c_str());
   std::printf("%-20s %-12s %-12s %10s %11s %8s %5s %9s %8s %8s %8s\n", "dataset", "method",
               "setting", "rpe_t_m/s", "rpe_r_deg/s", "ate_m", "lost", "median_ms", "cpu_ms",
               "spread_%", "vs_rgbd");
@@ -375,7 +382,9 @@ void printTable(const std::vector<Row>& rows, const Options& opt) {
 void writeJson(const std::vector<Row>& rows, const Options& opt) {
   std::ofstream out(opt.json);
   if (!out) throw std::runtime_error("cannot write " + opt.json);
-  out << "{\"rpe_delta_s\": 1, \"repeat\": " << opt.repeat << ", \"acvo_threads\": [";
+  out << "{\"rpe_delta_s\": 1, \"repeat\": " << opt.repeat;
+  if (!opt.camera.empty()) out << ", \"camera\": " << acvo::tools::jsonString(opt.camera);
+  out << ", \"acvo_threads\": [";
   for (std::size_t k = 0; k < opt.threads.size(); ++k) out << (k ? ", " : "") << opt.threads[k];
   out << "], \"runs\": [";
   for (std::size_t k = 0; k < rows.size(); ++k) {
@@ -411,7 +420,7 @@ int main(int argc, char** argv) {
     }
     std::vector<Row> rows;
     for (const auto& folder : opt.datasets) {
-      const acvo::TumDataset data(folder);
+      const acvo::TumDataset data(folder, opt.camera);
       // The dataset's frames used: every stride-th, at most --frames of them.
       std::vector<std::size_t> index;
       for (std::size_t i = 0; i < data.size(); i += std::size_t(opt.stride)) {

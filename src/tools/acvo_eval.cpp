@@ -20,6 +20,8 @@
 
 namespace {
 
+using acvo::tools::jsonString;
+
 namespace fs = std::filesystem;
 
 constexpr int kError = 2;
@@ -92,23 +94,6 @@ void printStats(const std::string& label, const acvo::ErrorStats& s, const char*
   for (const auto& [name, value] : rows) {
     std::printf("%s.%s %.6f %s\n", label.c_str(), name, value, unit);
   }
-}
-
-std::string jsonString(const std::string& text) {
-  std::string out = "\"";
-  for (const char c : text) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      char buffer[8];
-      std::snprintf(buffer, sizeof(buffer), "\\u%04x", c);
-      out += buffer;
-    } else {
-      out += c;
-    }
-  }
-  return out + "\"";
 }
 
 std::string jsonStats(const acvo::ErrorStats& s) {

@@ -29,15 +29,10 @@ struct ToolRun {
   }
 };
 
-ToolRun runTool(const std::string& arguments, const std::string& environment = "") {
-  const fs::path tool = acvo::test::toolsDir() / "acvo_eval";
+// Runs a shell command; stdout and the exit status.
+ToolRun runCommand(const std::string& command) {
   ToolRun run;
-  if (!fs::exists(tool)) {
-    ADD_FAILURE() << tool << " is not built";
-    return run;
-  }
-  FILE* pipe =
-      popen((environment + " '" + tool.string() + "' " + arguments + " 2>/dev/null").c_str(), "r");
+  FILE* pipe = popen((command + " 2>/dev/null").c_str(), "r");
   if (!pipe) return run;
   char buffer[4096];
   for (std::size_t n; (n = std::fread(buffer, 1, sizeof(buffer), pipe)) > 0;) {
@@ -46,6 +41,15 @@ ToolRun runTool(const std::string& arguments, const std::string& environment = "
   const int status = pclose(pipe);
   run.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return run;
+}
+
+ToolRun runTool(const std::string& arguments, const std::string& environment = "") {
+  const fs::path tool = acvo::test::toolsDir() / "acvo_eval";
+  if (!fs::exists(tool)) {
+    ADD_FAILURE() << tool << " is not built";
+    return {};
+  }
+  return runCommand(environment + " '" + tool.string() + "' " + arguments);
 }
 
 std::string fixtureArgs(const std::string& gt, const std::string& est) {
@@ -134,6 +138,41 @@ TEST(AcvoEval, FailedPlotStillReportsAndExitsWithThree) {
   EXPECT_EQ(run.status, 3);
   EXPECT_NEAR(figure(run.lastLine(), "rpe_trans_rmse"), 0.05, 1e-6);
   EXPECT_FALSE(fs::exists(png));
+}
+
+// scripts/window_errors on a camera turning about its y axis at 20 deg/s while moving along it
+// at 0.1 m/s, against an estimate that turns 10% less and travels 20% further: over 1 s windows
+// the turn ratio is 0.9, the travel ratio 1.2, the translation error 0.02 m per window, all of it
+// a bias along y; a reference with nothing in common is refused.
+TEST(WindowErrors, TurnAndTravelAgainstTheReference) {
+  const fs::path dir = acvo::test::tempDir("window_errors");
+  const double kPi = 3.14159265358979323846;
+  auto write = [&](const fs::path& path, double turn, double travel) {
+    std::ofstream out(path);
+    out.precision(12);
+    for (int i = 0; i <= 60; ++i) {
+      const double t = i / 30.0, half = 0.5 * turn * (20.0 * kPi / 180.0) * t;
+      out << 100.0 + t << " 0 " << travel * 0.1 * t << " 0 0 " << std::sin(half) << " 0 "
+          << std::cos(half) << "\n";
+    }
+  };
+  write(dir / "gt.txt", 1.0, 1.0);
+  write(dir / "est.txt", 0.9, 1.2);
+  const std::string script = "'" + (acvo::test::sourceDir() / "scripts/window_errors").string() +
+                             "' '" + (dir / "gt.txt").string() + "' ";
+  const ToolRun run = runCommand(script + "'" + (dir / "est.txt").string() + "'");
+  ASSERT_EQ(run.status, 0) << run.output;
+  EXPECT_NE(run.output.find("windows 31, reference turn 20.00 deg"), std::string::npos)
+      << run.output;
+  EXPECT_NE(run.output.find("rotation error rms 2.0000 deg, turn / reference 0.900"),
+            std::string::npos)
+      << run.output;
+  EXPECT_NE(run.output.find("translation error rms 0.0200 m, travel / reference 1.200, mean "
+                            "error (x y z) +0.0000 +0.0200 +0.0000 m"),
+            std::string::npos)
+      << run.output;
+  std::ofstream(dir / "elsewhen.txt") << "5.0 0 0 0 0 0 0 1\n6.0 0 0 0 0 0 0 1\n";
+  EXPECT_EQ(runCommand(script + "'" + (dir / "elsewhen.txt").string() + "'").status, 2);
 }
 
 }  // namespace
