@@ -389,9 +389,10 @@ void writeJson(const std::vector<Row>& rows, const Options& opt) {
   out << "], \"runs\": [";
   for (std::size_t k = 0; k < rows.size(); ++k) {
     const Row& r = rows[k];
-    out << (k ? ",\n  " : "\n  ") << "{\"dataset\": \"" << r.dataset << "\", \"method\": \""
-        << r.method << "\", \"setting\": \"" << r.setting
-        << "\", \"best\": " << (r.best ? "true" : "false")
+    out << (k ? ",\n  " : "\n  ") << "{\"dataset\": " << acvo::tools::jsonString(r.dataset)
+        << ", \"method\": " << acvo::tools::jsonString(r.method)
+        << ", \"setting\": " << acvo::tools::jsonString(r.setting)
+        << ", \"best\": " << (r.best ? "true" : "false")
         << ", \"frames\": " << r.trajectory.size() << ", \"rpe_trans\": " << jsonNumber(r.rpe_trans)
         << ", \"rpe_rot_deg\": " << jsonNumber(r.rpe_rot) << ", \"ate\": " << jsonNumber(r.ate)
         << ", \"lost\": " << r.lost << ", \"median_ms\": " << jsonNumber(median(r.median_ms))
