@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "acvo/camera.hpp"
 #include "test_support.hpp"
 
 namespace acvo {
@@ -195,16 +196,10 @@ TEST_F(CompareTool, StrideUsesEveryKthFrame) {
 // the JSON name the camera; one that is neither a file nor a known name is a bad argument.
 TEST_F(CompareTool, ACameraGivenReachesEveryMethod) {
   const fs::path room = dir_ / "room", camera = dir_ / "focal_5_percent_long.yaml";
-  {
-    std::ifstream in(room / "camera.yaml");
-    std::ofstream out(camera);
-    for (std::string line; std::getline(in, line);) {
-      if (line.rfind("fx:", 0) == 0 || line.rfind("fy:", 0) == 0) {
-        line = line.substr(0, 4) + std::to_string(1.05 * std::stod(line.substr(4)));
-      }
-      out << line << "\n";
-    }
-  }
+  Camera long_focal = loadCameraYaml((room / "camera.yaml").string());
+  long_focal.fx *= 1.05;
+  long_focal.fy *= 1.05;
+  saveCameraYaml(camera.string(), long_focal);
   const std::string common = "'" + room.string() + "' --methods acvo,icp --peer-max-depth 10";
   const fs::path own = dir_ / "own_camera.txt", given = dir_ / "given_camera.txt";
   const fs::path json = dir_ / "given_camera.json";
@@ -221,7 +216,8 @@ TEST_F(CompareTool, ACameraGivenReachesEveryMethod) {
   EXPECT_GT(std::stod(b[1][3]), 10.0 * std::max(std::stod(a[1][3]), 1e-4));
   EXPECT_GT(std::stod(b[1][3]), 0.01);
   EXPECT_GT(std::stod(b[2][3]), 2.0 * std::stod(a[2][3]));
-  const std::string header = readText(given).substr(0, readText(given).find('\n'));
+  const std::string given_text = readText(given);
+  const std::string header = given_text.substr(0, given_text.find('\n'));
   EXPECT_NE(header.find("; camera: " + camera.string()), std::string::npos) << header;
   EXPECT_EQ(readText(own).find("camera:"), std::string::npos);
   EXPECT_NE(readText(json).find("\"camera\": \"" + camera.string() + "\""), std::string::npos);
