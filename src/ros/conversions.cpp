@@ -1,7 +1,9 @@
 #include "conversions.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <sstream>
 #include <stdexcept>
 
 #include <image_geometry/pinhole_camera_model.h>
@@ -201,6 +203,29 @@ CameraResult cameraFor(const sensor_msgs::CameraInfo& info, int width, int heigh
   cam.height = height;
   cam.depth_scale = 1.0;  // the frame's depth is already in metres
   return out;
+}
+
+std::string describeCamera(const acvo::Camera& camera, const IntrinsicsOverride& source,
+                           const InputTopics& topics) {
+  std::ostringstream text;
+  text << "fx " << camera.fx << ", fy " << camera.fy << ", cx " << camera.cx << ", cy "
+       << camera.cy << " (" << camera.width << "x" << camera.height << ") ";
+  if (source.explicitValues()) {
+    text << "from the parameters fx, fy, cx, cy";
+  } else if (source.named()) {
+    text << "from the parameter camera: " << source.camera;
+  } else {
+    text << "from camera_info on " << topics.info;
+  }
+  return text.str();
+}
+
+bool nominalCameraInfo(const acvo::Camera& camera, const sensor_msgs::CameraInfo& info,
+                       const IntrinsicsOverride& source) {
+  if (source.explicitValues() || source.named()) return false;
+  const bool distorted =
+      std::any_of(info.D.begin(), info.D.end(), [](double d) { return d != 0.0; });
+  return !distorted && acvo::nominalIntrinsics(camera, acvo::LensDistortion{});
 }
 
 std::variant<acvo::Frame, Rejection> frameFromMessages(const sensor_msgs::Image& rgb,

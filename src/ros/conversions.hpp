@@ -72,6 +72,15 @@ struct InputTopics {
   std::string rgb, depth, info;
 };
 
+// The intrinsics in use and where they come from, for the log and the diagnostics, e.g.
+// "fx 585, fy 585, cx 320, cy 240 (640x480) from camera_info on /camera/rgb/camera_info".
+std::string describeCamera(const acvo::Camera& camera, const IntrinsicsOverride& source,
+                           const InputTopics& topics);
+// Whether the intrinsics in use are camera_info's and nominal rather than a calibration
+// (acvo::nominalIntrinsics, with camera_info's D all zero): a driver's or a dataset's defaults.
+bool nominalCameraInfo(const acvo::Camera& camera, const sensor_msgs::CameraInfo& info,
+                       const IntrinsicsOverride& source);
+
 // Why a set of messages was not made into a frame: a sentence naming the cause and the topic.
 struct Rejection {
   std::string why;

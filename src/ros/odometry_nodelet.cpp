@@ -95,6 +95,8 @@ class OdometryNodelet : public nodelet::Nodelet {
   void processFrame(const Image& rgb, const Image& depth, const Info& info);
   bool acceptStamp(const ros::Time& stamp);
   void reject(const std_msgs::Header& header, const std::string& why, double ms_total);
+  // Logs the intrinsics in use when they are new: at the first frame and at a change.
+  void noteCamera(const acvo::Camera& camera, const Info& info);
   // Logs the colour check's verdict when it comes (Odometry::colourCheck).
   void logColourVerdict(const acvo::OdometryResult& r);
   std::string baseFrame() const;
@@ -179,6 +181,10 @@ class OdometryNodelet : public nodelet::Nodelet {
   bool base_waited_ = false;  // waited once for base_from_camera_ (per camera frame)
   bool frame_ids_warned_ = false;
   bool depth_sync_told_ = false;  // said once that colour and depth stamps differ
+  // The intrinsics last logged, and the line that said them (for diagnostics): logged at the
+  // first frame and again whenever they change.
+  std::optional<acvo::Camera> camera_told_;
+  std::string camera_text_ = "none yet";
   ContinuousOdom continuous_;  // the published pose (odom_continuity.hpp)
   // A base pose to start from (initial_pose, or reset_odom_to_pose before the camera-to-base
   // transform was known): applied at the first frame whose transform is known.
@@ -353,6 +359,7 @@ void OdometryNodelet::processFrame(const Image& rgb, const Image& depth, const I
     NODELET_WARN_ONCE("%s has non-zero distortion: the images are used as if rectified",
                       topics_.info.c_str());
   }
+  noteCamera(frame.camera, info);
   const std::string depth_frame = stripSlash(depth.header.frame_id);
   if (!frame_ids_warned_ && depth_frame != header.frame_id) {
     frame_ids_warned_ = true;
@@ -459,6 +466,28 @@ bool OdometryNodelet::acceptStamp(const ros::Time& stamp) {
       return true;
   }
   return false;
+}
+
+void OdometryNodelet::noteCamera(const acvo::Camera& camera, const Info& info) {
+  const auto same = [](const acvo::Camera& a, const acvo::Camera& b) {
+    return a.fx == b.fx && a.fy == b.fy && a.cx == b.cx && a.cy == b.cy && a.width == b.width &&
+           a.height == b.height;
+  };
+  if (camera_told_ && same(*camera_told_, camera)) return;
+  camera_told_ = camera;
+  camera_text_ = describeCamera(camera, settings_.intrinsics, topics_);
+  if (nominalCameraInfo(camera, info, settings_.intrinsics)) {
+    camera_text_ += "; nominal, not a calibration";
+    NODELET_WARN(
+        "camera intrinsics: %s. Equal focal lengths, the principal point at the image's centre "
+        "and no distortion are a driver's defaults, not a calibration: exact for a simulated "
+        "camera, but a real one's may be a few percent off, and acvo, which registers the depth's "
+        "geometry, carries that in full in its translation. Calibrate the camera "
+        "(camera_calibration) or set ~fx, ~fy, ~cx, ~cy",
+        camera_text_.c_str());
+  } else {
+    NODELET_INFO("camera intrinsics: %s", camera_text_.c_str());
+  }
 }
 
 void OdometryNodelet::logColourVerdict(const acvo::OdometryResult& r) {
@@ -771,6 +800,7 @@ void OdometryNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat
   stat.add("frames dropped while paused", count_.paused);
   stat.add("last tracking", acvo::toString(last_.tracking));
   stat.add("last message", last_.message);
+  stat.add("camera intrinsics", camera_text_);
   stat.add("last ms total", last_.ms_total);
   stat.add("last ms latency", last_.ms_latency);
   stat.add("colour/depth registration",

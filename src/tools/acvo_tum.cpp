@@ -94,6 +94,13 @@ int main(int argc, char** argv) {
                 << k[1] << ' ' << k[2] << ' ' << k[3] << ' ' << k[4]
                 << "): every frame undistorted on loading\n";
     }
+    if (acvo::nominalIntrinsics(data.camera(), data.distortion())) {
+      const acvo::Camera& c = data.camera();
+      std::cerr << "acvo_tum: note: the intrinsics (fx " << c.fx << ", fy " << c.fy << ", cx "
+                << c.cx << ", cy " << c.cy << ") are nominal, not a calibration: exact for a "
+                << "rendered camera; a real one's may be a few percent off, and acvo's translation "
+                << "carries that in full (--camera FILE gives a calibration)\n";
+    }
     const std::string output =
         opt.output.empty() ? opt.dataset + "/acvo_trajectory.txt" : opt.output;
     const long first = std::min<long>(opt.start, long(data.size()));

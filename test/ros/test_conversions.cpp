@@ -233,6 +233,41 @@ TEST(CameraFor, OverridesWinOverCameraInfo) {
   EXPECT_FALSE(info_name.named());
 }
 
+// The intrinsics in use are said with their source; camera_info's are told nominal when they
+// are a driver's defaults (7-Scenes' 585 px about the centre here), and a calibration, a lens
+// or the user's own values are not.
+TEST(DescribeCamera, SaysTheIntrinsicsTheirSourceAndWhetherTheyAreNominal) {
+  const InputTopics topics{"/rgb", "/depth", "/camera/rgb/camera_info"};
+  const sensor_msgs::CameraInfo nominal = info(585, 585, 320, 240, 640, 480);
+  const CameraResult from_info = cameraFor(nominal, 640, 480, {});
+  ASSERT_EQ(from_info.problem, "");
+  EXPECT_EQ(describeCamera(from_info.camera, {}, topics),
+            "fx 585, fy 585, cx 320, cy 240 (640x480) from camera_info on "
+            "/camera/rgb/camera_info");
+  EXPECT_TRUE(nominalCameraInfo(from_info.camera, nominal, {}));
+
+  sensor_msgs::CameraInfo distorted = nominal;
+  distorted.D = {0.1, 0, 0, 0, 0};
+  EXPECT_FALSE(nominalCameraInfo(cameraFor(distorted, 640, 480, {}).camera, distorted, {}));
+  const sensor_msgs::CameraInfo calibrated = info(535.4, 539.2, 320.1, 247.6, 640, 480);
+  EXPECT_FALSE(nominalCameraInfo(cameraFor(calibrated, 640, 480, {}).camera, calibrated, {}));
+
+  IntrinsicsOverride named;
+  named.camera = "default";
+  const CameraResult tum_default = cameraFor(nominal, 640, 480, named);
+  EXPECT_EQ(describeCamera(tum_default.camera, named, topics),
+            "fx 525, fy 525, cx 319.5, cy 239.5 (640x480) from the parameter camera: default");
+  EXPECT_FALSE(nominalCameraInfo(tum_default.camera, nominal, named)) << "the user's choice";
+  IntrinsicsOverride values;
+  values.fx = values.fy = 585;
+  values.cx = 320;
+  values.cy = 240;
+  const CameraResult given = cameraFor(nominal, 640, 480, values);
+  EXPECT_EQ(describeCamera(given.camera, values, topics),
+            "fx 585, fy 585, cx 320, cy 240 (640x480) from the parameters fx, fy, cx, cy");
+  EXPECT_FALSE(nominalCameraInfo(given.camera, nominal, values));
+}
+
 Eigen::Isometry3d pose(double rx, double ry, double rz, double x, double y, double z) {
   Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
   t.linear() = (Eigen::AngleAxisd(rz, Eigen::Vector3d::UnitZ()) *

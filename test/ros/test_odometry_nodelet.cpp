@@ -14,6 +14,7 @@
 // 2x2 binning for the 320x240 images, and a raw-image K that differs from P), depth_frame (the
 // depth images' frame_id, when it differs from the colour's), bad_params (the .test gives the
 // nodelet a bad and an unknown parameter).
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <mutex>
@@ -350,6 +351,14 @@ class Client {
     }
   }
 
+  // How many warnings and errors on /rosout so far contain `text`.
+  std::size_t countLogs(const std::string& text) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return std::count_if(logs_.begin(), logs_.end(), [&](const auto& log) {
+      return log.second.find(text) != std::string::npos;
+    });
+  }
+
   bool reset() {
     std_srvs::Empty srv;
     return reset_.call(srv);
@@ -622,6 +631,26 @@ TEST(OdometryNodelet, TracksKnownMotionWithRightFramesCovarianceAndTf) {
   ASSERT_TRUE(diag);
   EXPECT_EQ(diag->level, level) << diag->message;
   EXPECT_EQ(diag->message, message);
+}
+
+// The test camera's intrinsics are nominal (equal focal lengths about a 320x240 image's
+// centre, no distortion): the diagnostics say what is in use and where it comes from, and the
+// log warns once, at the first frame, that a real camera with these wants calibrating.
+TEST(OdometryNodelet, TheIntrinsicsInUseAreSaidAndNominalOnesWarnedOnce) {
+  ASSERT_TRUE(client->reset());
+  client->run(range(0, 3));
+  const auto said = client->diagnosticValueOnce(
+      "camera intrinsics", [](const std::string& v) { return v != "none yet"; });
+  ASSERT_TRUE(said);
+  EXPECT_EQ(said->rfind("fx 262.5, fy 262.5, cx 159.5, cy 119.5 (320x240) from camera_info on ",
+                        0),
+            0u)
+      << *said;
+  EXPECT_NE(said->find("cam/info; nominal, not a calibration"), std::string::npos) << *said;
+  const auto warning = client->waitLog("camera intrinsics: fx 262.5", ros::WallTime());
+  ASSERT_TRUE(warning) << "no warning about the nominal intrinsics";
+  EXPECT_NE(warning->find("camera_calibration"), std::string::npos) << *warning;
+  EXPECT_EQ(client->countLogs("camera intrinsics:"), 1u) << "the same intrinsics told again";
 }
 
 TEST(OdometryNodelet, CloudIsPublishedToASubscriberInTheCameraFrame) {

@@ -42,6 +42,40 @@ TEST(Camera, TumNamesGiveThePublishedIntrinsics) {
   }
 }
 
+TEST(Camera, NominalIntrinsicsAreTheDefaultsNotACalibration) {
+  const acvo::LensDistortion none;
+  // TUM's default and 7-Scenes' (585 px about the image's centre): nominal.
+  EXPECT_TRUE(acvo::nominalIntrinsics(acvo::cameraByName("default"), none));
+  Camera seven_scenes;
+  seven_scenes.fx = seven_scenes.fy = 585.0;
+  seven_scenes.cx = 320.0;
+  seven_scenes.cy = 240.0;
+  EXPECT_TRUE(acvo::nominalIntrinsics(seven_scenes, none));
+  // A simulator's centre at (w + 1) / 2, at another size.
+  Camera simulated;
+  simulated.width = 1280;
+  simulated.height = 720;
+  simulated.fx = simulated.fy = 1108.5;
+  simulated.cx = 640.5;
+  simulated.cy = 360.5;
+  EXPECT_TRUE(acvo::nominalIntrinsics(simulated, none));
+  // Calibrations: TUM's three, and the defaults with any one value moved.
+  for (const char* name : {"fr1", "fr2", "fr3"}) {
+    EXPECT_FALSE(acvo::nominalIntrinsics(acvo::cameraByName(name), none)) << name;
+  }
+  Camera moved = seven_scenes;
+  moved.fy = 585.5;
+  EXPECT_FALSE(acvo::nominalIntrinsics(moved, none));
+  moved = seven_scenes;
+  moved.cx = 320.3;
+  EXPECT_FALSE(acvo::nominalIntrinsics(moved, none));
+  moved = seven_scenes;
+  moved.cy = 241.0;  // (h + 2) / 2: no convention's centre
+  EXPECT_FALSE(acvo::nominalIntrinsics(moved, none));
+  // A lens that was calibrated makes the intrinsics a calibration too.
+  EXPECT_FALSE(acvo::nominalIntrinsics(seven_scenes, acvo::distortionByName("fr1")));
+}
+
 TEST(Camera, UnknownNameThrows) {
   EXPECT_THROW(acvo::cameraByName("fr4"), std::invalid_argument);
   EXPECT_THROW(acvo::cameraByName(""), std::invalid_argument);

@@ -47,6 +47,16 @@ LensDistortion distortionByName(const std::string& name) {
   return d;
 }
 
+bool nominalIntrinsics(const Camera& camera, const LensDistortion& distortion) {
+  auto centred = [](double c, int size) {
+    constexpr std::array<double, 3> kShifts{0.0, -1.0, 1.0};
+    return std::any_of(kShifts.begin(), kShifts.end(),
+                       [&](double shift) { return std::abs(c - 0.5 * (size + shift)) < 1e-6; });
+  };
+  return !distortion.any() && std::abs(camera.fx - camera.fy) < 1e-6 &&
+         centred(camera.cx, camera.width) && centred(camera.cy, camera.height);
+}
+
 namespace {
 
 std::string notANumber(const std::string& key) {
