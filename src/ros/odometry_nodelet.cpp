@@ -483,7 +483,7 @@ void OdometryNodelet::noteCamera(const acvo::Camera& camera, const Info& info) {
         "and no distortion are a driver's defaults, not a calibration: exact for a simulated "
         "camera, but a real one's may be a few percent off, and acvo, which registers the depth's "
         "geometry, carries that in full in its translation. Calibrate the camera "
-        "(camera_calibration) or set ~fx, ~fy, ~cx, ~cy",
+        "(camera_calibration) or set ~fx, ~fy, ~cx, ~cy; for a TUM bag, ~camera fr1, fr2 or fr3",
         camera_text_.c_str());
   } else {
     NODELET_INFO("camera intrinsics: %s", camera_text_.c_str());
