@@ -110,6 +110,16 @@ inline constexpr double kSecondStartInterval = 1.0 / 30.0;  // s
 // rendered rooms at 0.6 and 0.8 m/s). 1.1 and 1.3 measured the same as 1.2 (docs/accuracy.md,
 // eighteenth round).
 inline constexpr double kSecondStartMargin = 1.2;
+// A kept second start says that something in view pulls the registration away from the camera's
+// own motion: for kSecondStartMemory seconds after one, the first start must score
+// kSecondStartKeptMargin times the second's to be kept instead. A person walking at 0.5 m/s
+// (acvo_synth --walker 0.5, seed 62) is outscored by the room as it enters and then, filling
+// more of the view, outscores it by up to 1.42x: with the plain margin the registration followed
+// it for 30 frames (35 mm a frame). A camera's own jerk leaves the second start 5-8x lower, above
+// this margin. Margins of 1.5-3 and memories of 3-30 frames at 30 Hz measured alike; 1 frame did
+// not hold (docs/accuracy.md, twenty-first round).
+inline constexpr double kSecondStartKeptMargin = 2.0;
+inline constexpr double kSecondStartMemory = 0.25;  // s
 
 // Tracking judgement of a registration, from the solver's result and the motion it implies
 // from the last tracked frame (`frame_motion`; the registration's own transform when the frame
@@ -170,7 +180,8 @@ bool replacesReference(const SolverResult& s, std::size_t points, std::size_t re
 //  - either: a registration whose motion misses the prior by more than kSecondStartTranslation
 //    or kSecondStartRotation is run again at the finest level from the prior, and that second
 //    start is kept unless the first's kernel value there is kSecondStartMargin times higher
-//    (OdometryParams::second_start).
+//    (kSecondStartKeptMargin within kSecondStartMemory of a kept one;
+//    OdometryParams::second_start).
 class Odometry {
  public:
   explicit Odometry(const Params& params = Params());
@@ -266,9 +277,10 @@ class Odometry {
                           const Eigen::Isometry3d& guess, const Frame& frame, OdometryResult& r);
   // Where reg's motion missed `guess` (OdometryParams::second_start, kSecondStartTranslation),
   // the finest level again from the guess, kept unless the first scores kSecondStartMargin
-  // times higher.
+  // times higher (kSecondStartKeptMargin within kSecondStartMemory of the last one kept; `stamp`
+  // is the frame's).
   void secondStart(const Tracked& reference, const Eigen::Isometry3d& guess, Registration& reg,
-                   OdometryResult& r);
+                   OdometryResult& r, double stamp);
   // Whether registrations of this frame move its depth again (sync_depth, a delay, a staged
   // engine).
   bool retimes(const OdometryResult& r) const;
@@ -294,6 +306,7 @@ class Odometry {
   std::optional<Tracked> keyframe_;
   std::optional<Tracked> last_;  // the last tracked frame (the keyframe itself, or after it)
   int lost_in_a_row_ = 0;
+  std::optional<double> second_start_kept_at_;  // the stamp of the last frame that kept one
   std::uint64_t frames_ = 0;  // frames numbered so far
   ColourDepthCheck colour_check_;
   // Each frame's colour is resampled by it (colourResampling), and by the verdict's baseline with

@@ -194,7 +194,8 @@ struct OdometryParams {
   // kSecondStartTranslation or kSecondStartRotation in one frame (odometry.hpp; more than a
   // hand-held camera's velocity changes in a frame: up to 20 mm on the real folders), the
   // finest level is run again from the guess, and that result is kept unless the first's kernel
-  // value there is kSecondStartMargin times higher. A person crossing a third of the view can
+  // value there is kSecondStartMargin times higher (kSecondStartKeptMargin within
+  // kSecondStartMemory of a frame that kept one). A person crossing a third of the view can
   // pull the coarse levels, whose kernel spans both motions, into the person's motion; the
   // finest level's narrow kernel, started from the camera's own predicted motion, holds the
   // still part (docs/accuracy.md, eighteenth round). Off: the paper's single start.

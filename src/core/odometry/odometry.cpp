@@ -194,6 +194,7 @@ void Odometry::reset(const Eigen::Isometry3d& pose, const Matrix6d& covariance) 
   keyframe_.reset();
   last_.reset();
   lost_in_a_row_ = 0;
+  second_start_kept_at_.reset();
 }
 
 std::optional<double> Odometry::lastTrackedStamp() const {
@@ -254,7 +255,7 @@ Odometry::Registration Odometry::registerTo(const Tracked& reference,
         coarse, engine_->align(*reference.cloud, *reg.moving, coarse.transform,
                                AlignStages::kFinest));
   });
-  if (params_.odometry.second_start) secondStart(reference, guess, reg, r);
+  if (params_.odometry.second_start) secondStart(reference, guess, reg, r, frame.stamp);
   reg.judgement = judgeTracking(reg.solver, frameMotion(reg.solver.transform), params_.odometry);
   const SolverResult& s = reg.solver;
   if (failed(s.status)) {
@@ -518,7 +519,7 @@ void Odometry::start(OdometryResult& r, const std::shared_ptr<PreparedCloud>& re
 }
 
 void Odometry::secondStart(const Tracked& reference, const Eigen::Isometry3d& guess,
-                           Registration& reg, OdometryResult& r) {
+                           Registration& reg, OdometryResult& r, double stamp) {
   if (failed(reg.solver.status)) return;
   // Both transforms map into the reference: guess^-1 T is the registered frame motion against
   // the guessed one, from any reference.
@@ -538,10 +539,12 @@ void Odometry::secondStart(const Tracked& reference, const Eigen::Isometry3d& gu
   reg.solver.ms_total += again.ms_total;
   reg.solver.ms_neighbours += again.ms_neighbours;
   reg.solver.iterations += again.iterations;
-  if (failed(again.status) || !(kSecondStartMargin * again.objective > reg.solver.objective)) {
-    return;
-  }
+  const bool pulled_lately = second_start_kept_at_ && stamp >= *second_start_kept_at_ &&
+                            stamp - *second_start_kept_at_ <= kSecondStartMemory;
+  const double margin = pulled_lately ? kSecondStartKeptMargin : kSecondStartMargin;
+  if (failed(again.status) || !(margin * again.objective > reg.solver.objective)) return;
   r.second_start_kept = true;
+  second_start_kept_at_ = stamp;
   again.iterations = reg.solver.iterations;
   again.ms_total = reg.solver.ms_total;
   again.ms_neighbours = reg.solver.ms_neighbours;
