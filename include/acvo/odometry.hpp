@@ -111,13 +111,14 @@ inline constexpr double kSecondStartInterval = 1.0 / 30.0;  // s
 // eighteenth round).
 inline constexpr double kSecondStartMargin = 1.2;
 // A kept second start says that something in view pulls the registration away from the camera's
-// own motion: for kSecondStartMemory seconds after one, the first start must score
-// kSecondStartKeptMargin times the second's to be kept instead. A person walking at 0.5 m/s
-// (acvo_synth --walker 0.5, seed 62) is outscored by the room as it enters and then, filling
-// more of the view, outscores it by up to 1.42x: with the plain margin the registration followed
-// it for 30 frames (35 mm a frame). A camera's own jerk leaves the second start 5-8x lower, above
-// this margin. Margins of 1.5-3 and memories of 3-30 frames at 30 Hz measured alike; 1 frame did
-// not hold (docs/accuracy.md, twenty-first round).
+// own motion: for kSecondStartMemory seconds after a tracked frame that kept one, the first start
+// must score kSecondStartKeptMargin times the second's to be kept instead. A person walking at
+// 0.5 m/s (acvo_synth --walker 0.5, seed 62) is outscored by the room as it enters and then,
+// filling more of the view, outscores it by up to 1.42x: with the plain margin the registration
+// followed it for 30 frames, 35 mm a frame off. A camera's own jerk leaves the second start 5-8x
+// lower, above this margin. Margins of 1.5-3 and memories of 3-30 frames at 30 Hz measured
+// alike; 1 frame did not hold (docs/accuracy.md, twenty-first round). Frames more than the
+// memory apart (under 4 Hz) keep the plain margin.
 inline constexpr double kSecondStartKeptMargin = 2.0;
 inline constexpr double kSecondStartMemory = 0.25;  // s
 
@@ -306,7 +307,9 @@ class Odometry {
   std::optional<Tracked> keyframe_;
   std::optional<Tracked> last_;  // the last tracked frame (the keyframe itself, or after it)
   int lost_in_a_row_ = 0;
-  std::optional<double> second_start_kept_at_;  // the stamp of the last frame that kept one
+  // The stamp of the last tracked frame whose registration kept a second start (none after a
+  // lost frame or a reset).
+  std::optional<double> second_start_kept_at_;
   std::uint64_t frames_ = 0;  // frames numbered so far
   ColourDepthCheck colour_check_;
   // Each frame's colour is resampled by it (colourResampling), and by the verdict's baseline with

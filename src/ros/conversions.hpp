@@ -78,6 +78,8 @@ std::string describeCamera(const acvo::Camera& camera, const IntrinsicsOverride&
                            const InputTopics& topics);
 // Whether the intrinsics in use are camera_info's and nominal rather than a calibration
 // (acvo::nominalIntrinsics, with camera_info's D all zero): a driver's or a dataset's defaults.
+// A binned stream is judged by its reduced intrinsics (image_geometry's cx / binning), which
+// fall on none of the centre's conventions: nominal ones binned are not recognised.
 bool nominalCameraInfo(const acvo::Camera& camera, const sensor_msgs::CameraInfo& info,
                        const IntrinsicsOverride& source);
 

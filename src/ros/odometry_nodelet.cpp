@@ -65,6 +65,8 @@ constexpr double kNoSyncWarning = 5.0;
 constexpr double kSkipWarning = 5.0;
 // Period of the warning about a motion guess that could not be looked up (s).
 constexpr double kGuessWarning = 10.0;
+// Period of the note on the camera intrinsics in use, when they change (s).
+constexpr double kCameraNote = 5.0;
 
 double msSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
@@ -184,6 +186,7 @@ class OdometryNodelet : public nodelet::Nodelet {
   // The intrinsics last logged, and the line that said them (for diagnostics): logged at the
   // first frame and again whenever they change.
   std::optional<acvo::Camera> camera_told_;
+  bool camera_told_nominal_ = false;
   std::string camera_text_ = "none yet";
   ContinuousOdom continuous_;  // the published pose (odom_continuity.hpp)
   // A base pose to start from (initial_pose, or reset_odom_to_pose before the camera-to-base
@@ -473,12 +476,15 @@ void OdometryNodelet::noteCamera(const acvo::Camera& camera, const Info& info) {
     return a.fx == b.fx && a.fy == b.fy && a.cx == b.cx && a.cy == b.cy && a.width == b.width &&
            a.height == b.height;
   };
-  if (camera_told_ && same(*camera_told_, camera)) return;
+  const bool nominal = nominalCameraInfo(camera, info, settings_.intrinsics);
+  if (camera_told_ && same(*camera_told_, camera) && nominal == camera_told_nominal_) return;
   camera_told_ = camera;
+  camera_told_nominal_ = nominal;
   camera_text_ = describeCamera(camera, settings_.intrinsics, topics_);
-  if (nominalCameraInfo(camera, info, settings_.intrinsics)) {
+  // Throttled: a topic whose camera_info alternates between two cameras changes on every frame.
+  if (nominal) {
     camera_text_ += "; nominal, not a calibration";
-    NODELET_WARN(
+    NODELET_WARN_THROTTLE(kCameraNote,
         "camera intrinsics: %s. Equal focal lengths, the principal point at the image's centre "
         "and no distortion are a driver's defaults, not a calibration: exact for a simulated "
         "camera, but a real one's may be a few percent off, and acvo, which registers the depth's "
@@ -486,7 +492,7 @@ void OdometryNodelet::noteCamera(const acvo::Camera& camera, const Info& info) {
         "(camera_calibration) or set ~fx, ~fy, ~cx, ~cy; for a TUM bag, ~camera fr1, fr2 or fr3",
         camera_text_.c_str());
   } else {
-    NODELET_INFO("camera intrinsics: %s", camera_text_.c_str());
+    NODELET_INFO_THROTTLE(kCameraNote, "camera intrinsics: %s", camera_text_.c_str());
   }
 }
 

@@ -99,7 +99,8 @@ int main(int argc, char** argv) {
       std::cerr << "acvo_tum: note: the intrinsics (fx " << c.fx << ", fy " << c.fy << ", cx "
                 << c.cx << ", cy " << c.cy << ") are nominal, not a calibration: exact for a "
                 << "rendered camera; a real one's may be a few percent off, and acvo's translation "
-                << "carries that in full (--camera FILE gives a calibration)\n";
+                << "carries that in full (--camera FILE gives a calibration; fr1, fr2 or fr3, "
+                << "TUM's)\n";
     }
     const std::string output =
         opt.output.empty() ? opt.dataset + "/acvo_trajectory.txt" : opt.output;

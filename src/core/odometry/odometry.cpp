@@ -36,6 +36,7 @@ struct Odometry::Registration {
   Judgement judgement;
   Matrix6d covariance = lostCovariance();  // of the motion, when tracked
   std::size_t fixed_points = 0;
+  bool second_start_kept = false;  // secondStart's result replaced the first start's
 };
 
 std::string toString(Tracking t) {
@@ -394,8 +395,10 @@ OdometryResult Odometry::track(const Frame& frame,
   }
   if (reg.judgement.tracking == Tracking::kLost) {
     lost(r, reg, reg.moving, frame.stamp);
+    second_start_kept_at_.reset();
   } else {
     tracked(r, reg, reg.moving);
+    if (reg.second_start_kept) second_start_kept_at_ = frame.stamp;
   }
   return r;
 }
@@ -544,7 +547,7 @@ void Odometry::secondStart(const Tracked& reference, const Eigen::Isometry3d& gu
   const double margin = pulled_lately ? kSecondStartKeptMargin : kSecondStartMargin;
   if (failed(again.status) || !(margin * again.objective > reg.solver.objective)) return;
   r.second_start_kept = true;
-  second_start_kept_at_ = stamp;
+  reg.second_start_kept = true;
   again.iterations = reg.solver.iterations;
   again.ms_total = reg.solver.ms_total;
   again.ms_neighbours = reg.solver.ms_neighbours;
