@@ -220,12 +220,15 @@ std::string describeCamera(const acvo::Camera& camera, const IntrinsicsOverride&
   return text.str();
 }
 
+bool distortedCameraInfo(const sensor_msgs::CameraInfo& info, const IntrinsicsOverride& source) {
+  return source.fromCameraInfo() &&
+         std::any_of(info.D.begin(), info.D.end(), [](double d) { return d != 0.0; });
+}
+
 bool nominalCameraInfo(const acvo::Camera& camera, const sensor_msgs::CameraInfo& info,
                        const IntrinsicsOverride& source) {
-  if (source.explicitValues() || source.named()) return false;
-  const bool distorted =
-      std::any_of(info.D.begin(), info.D.end(), [](double d) { return d != 0.0; });
-  return !distorted && acvo::nominalIntrinsics(camera, acvo::LensDistortion{});
+  return source.fromCameraInfo() && !distortedCameraInfo(info, source) &&
+         acvo::nominalIntrinsics(camera, acvo::LensDistortion{});
 }
 
 std::variant<acvo::Frame, Rejection> frameFromMessages(const sensor_msgs::Image& rgb,

@@ -52,6 +52,7 @@ struct IntrinsicsOverride {
 
   bool explicitValues() const { return fx > 0.0 && fy > 0.0 && cx > 0.0 && cy > 0.0; }
   bool named() const { return !camera.empty() && camera != "info"; }
+  bool fromCameraInfo() const { return !explicitValues() && !named(); }
   // Empty when consistent; otherwise says what is wrong (unknown name, partial fx..cy).
   std::string problem() const;
 };
@@ -76,6 +77,9 @@ struct InputTopics {
 // "fx 585, fy 585, cx 320, cy 240 (640x480) from camera_info on /camera/rgb/camera_info".
 std::string describeCamera(const acvo::Camera& camera, const IntrinsicsOverride& source,
                            const InputTopics& topics);
+// Whether the intrinsics in use are camera_info's and its D has a non-zero coefficient (the
+// images are then used as if rectified).
+bool distortedCameraInfo(const sensor_msgs::CameraInfo& info, const IntrinsicsOverride& source);
 // Whether the intrinsics in use are camera_info's and nominal rather than a calibration
 // (acvo::nominalIntrinsics, with camera_info's D all zero): a driver's or a dataset's defaults.
 // A binned stream is judged by its reduced intrinsics (image_geometry's cx / binning), which

@@ -357,8 +357,7 @@ void OdometryNodelet::processFrame(const Image& rgb, const Image& depth, const I
     NODELET_WARN_ONCE("%s is mono8: points get intensity and gradient labels but no colour",
                       topics_.rgb.c_str());
   }
-  if (!settings_.intrinsics.named() && !settings_.intrinsics.explicitValues() &&
-      std::any_of(info.D.begin(), info.D.end(), [](double d) { return d != 0.0; })) {
+  if (distortedCameraInfo(info, settings_.intrinsics)) {
     NODELET_WARN_ONCE("%s has non-zero distortion: the images are used as if rectified",
                       topics_.info.c_str());
   }

@@ -249,6 +249,8 @@ TEST(DescribeCamera, SaysTheIntrinsicsTheirSourceAndWhetherTheyAreNominal) {
   sensor_msgs::CameraInfo distorted = nominal;
   distorted.D = {0.1, 0, 0, 0, 0};
   EXPECT_FALSE(nominalCameraInfo(cameraFor(distorted, 640, 480, {}).camera, distorted, {}));
+  EXPECT_TRUE(distortedCameraInfo(distorted, {}));
+  EXPECT_FALSE(distortedCameraInfo(nominal, {}));
   const sensor_msgs::CameraInfo calibrated = info(535.4, 539.2, 320.1, 247.6, 640, 480);
   EXPECT_FALSE(nominalCameraInfo(cameraFor(calibrated, 640, 480, {}).camera, calibrated, {}));
 
@@ -258,6 +260,7 @@ TEST(DescribeCamera, SaysTheIntrinsicsTheirSourceAndWhetherTheyAreNominal) {
   EXPECT_EQ(describeCamera(tum_default.camera, named, topics),
             "fx 525, fy 525, cx 319.5, cy 239.5 (640x480) from the parameter camera: default");
   EXPECT_FALSE(nominalCameraInfo(tum_default.camera, nominal, named)) << "the user's choice";
+  EXPECT_FALSE(distortedCameraInfo(distorted, named)) << "camera_info's D not in use";
   IntrinsicsOverride values;
   values.fx = values.fy = 585;
   values.cx = 320;
