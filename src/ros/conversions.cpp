@@ -225,10 +225,19 @@ bool distortedCameraInfo(const sensor_msgs::CameraInfo& info, const IntrinsicsOv
          std::any_of(info.D.begin(), info.D.end(), [](double d) { return d != 0.0; });
 }
 
-bool nominalCameraInfo(const acvo::Camera& camera, const sensor_msgs::CameraInfo& info,
-                       const IntrinsicsOverride& source) {
-  return source.fromCameraInfo() && !distortedCameraInfo(info, source) &&
-         acvo::nominalIntrinsics(camera, acvo::LensDistortion{});
+bool nominalCameraInfo(const sensor_msgs::CameraInfo& info, const IntrinsicsOverride& source) {
+  if (!source.fromCameraInfo() || distortedCameraInfo(info, source)) return false;
+  // The full sensor's intrinsics, before binning and a region of interest (P, or K where P is all
+  // zero, as cameraFor reads them): a driver's defaults are about that image's centre.
+  const bool has_p = info.P[0] != 0.0 || info.P[5] != 0.0;
+  acvo::Camera full;
+  full.fx = has_p ? info.P[0] : info.K[0];
+  full.fy = has_p ? info.P[5] : info.K[4];
+  full.cx = has_p ? info.P[2] : info.K[2];
+  full.cy = has_p ? info.P[6] : info.K[5];
+  full.width = int(info.width);
+  full.height = int(info.height);
+  return acvo::nominalIntrinsics(full, acvo::LensDistortion{});
 }
 
 std::variant<acvo::Frame, Rejection> frameFromMessages(const sensor_msgs::Image& rgb,

@@ -82,10 +82,9 @@ std::string describeCamera(const acvo::Camera& camera, const IntrinsicsOverride&
 bool distortedCameraInfo(const sensor_msgs::CameraInfo& info, const IntrinsicsOverride& source);
 // Whether the intrinsics in use are camera_info's and nominal rather than a calibration
 // (acvo::nominalIntrinsics, with camera_info's D all zero): a driver's or a dataset's defaults.
-// A binned stream is judged by its reduced intrinsics (image_geometry's cx / binning), which
-// fall on none of the centre's conventions: nominal ones binned are not recognised.
-bool nominalCameraInfo(const acvo::Camera& camera, const sensor_msgs::CameraInfo& info,
-                       const IntrinsicsOverride& source);
+// Judged at camera_info's full resolution (its P or K and width x height), so a binned stream
+// or a region of interest of a nominal camera is told nominal too.
+bool nominalCameraInfo(const sensor_msgs::CameraInfo& info, const IntrinsicsOverride& source);
 
 // Why a set of messages was not made into a frame: a sentence naming the cause and the topic.
 struct Rejection {

@@ -475,7 +475,7 @@ void OdometryNodelet::noteCamera(const acvo::Camera& camera, const Info& info) {
     return a.fx == b.fx && a.fy == b.fy && a.cx == b.cx && a.cy == b.cy && a.width == b.width &&
            a.height == b.height;
   };
-  const bool nominal = nominalCameraInfo(camera, info, settings_.intrinsics);
+  const bool nominal = nominalCameraInfo(info, settings_.intrinsics);
   if (camera_told_ && same(*camera_told_, camera) && nominal == camera_told_nominal_) return;
   camera_told_ = camera;
   camera_told_nominal_ = nominal;

@@ -244,22 +244,45 @@ TEST(DescribeCamera, SaysTheIntrinsicsTheirSourceAndWhetherTheyAreNominal) {
   EXPECT_EQ(describeCamera(from_info.camera, {}, topics),
             "fx 585, fy 585, cx 320, cy 240 (640x480) from camera_info on "
             "/camera/rgb/camera_info");
-  EXPECT_TRUE(nominalCameraInfo(from_info.camera, nominal, {}));
+  EXPECT_TRUE(nominalCameraInfo(nominal, {}));
 
   sensor_msgs::CameraInfo distorted = nominal;
   distorted.D = {0.1, 0, 0, 0, 0};
-  EXPECT_FALSE(nominalCameraInfo(cameraFor(distorted, 640, 480, {}).camera, distorted, {}));
+  EXPECT_FALSE(nominalCameraInfo(distorted, {}));
   EXPECT_TRUE(distortedCameraInfo(distorted, {}));
   EXPECT_FALSE(distortedCameraInfo(nominal, {}));
   const sensor_msgs::CameraInfo calibrated = info(535.4, 539.2, 320.1, 247.6, 640, 480);
-  EXPECT_FALSE(nominalCameraInfo(cameraFor(calibrated, 640, 480, {}).camera, calibrated, {}));
+  EXPECT_FALSE(nominalCameraInfo(calibrated, {}));
+
+  // A binned stream and a region of interest of a nominal camera: the intrinsics in use are
+  // reduced (TUM's default cx 319.5 is 159.75 with 2x2 binning, none of the 320x240 image's
+  // centres) and still nominal; P, where it is filled, is what is judged.
+  sensor_msgs::CameraInfo binned = info(525, 525, 319.5, 239.5, 640, 480);
+  EXPECT_TRUE(nominalCameraInfo(binned, {}));
+  binned.binning_x = binned.binning_y = 2;
+  const CameraResult reduced = cameraFor(binned, 320, 240, {});
+  ASSERT_EQ(reduced.problem, "");
+  EXPECT_DOUBLE_EQ(reduced.camera.cx, 159.75);
+  EXPECT_FALSE(acvo::nominalIntrinsics(reduced.camera, acvo::LensDistortion{}));
+  EXPECT_TRUE(nominalCameraInfo(binned, {}));
+  sensor_msgs::CameraInfo cropped = nominal;
+  cropped.roi.x_offset = 100;
+  cropped.roi.width = 320;
+  cropped.roi.height = 480;
+  ASSERT_EQ(cameraFor(cropped, 320, 480, {}).problem, "");
+  EXPECT_TRUE(nominalCameraInfo(cropped, {}));
+  sensor_msgs::CameraInfo projected = calibrated;
+  projected.P = {585, 0, 320, 0, 0, 585, 240, 0, 0, 0, 1, 0};
+  EXPECT_TRUE(nominalCameraInfo(projected, {})) << "P, not K, is in use";
+  projected.P[2] = 320.6;
+  EXPECT_FALSE(nominalCameraInfo(projected, {}));
 
   IntrinsicsOverride named;
   named.camera = "default";
   const CameraResult tum_default = cameraFor(nominal, 640, 480, named);
   EXPECT_EQ(describeCamera(tum_default.camera, named, topics),
             "fx 525, fy 525, cx 319.5, cy 239.5 (640x480) from the parameter camera: default");
-  EXPECT_FALSE(nominalCameraInfo(tum_default.camera, nominal, named)) << "the user's choice";
+  EXPECT_FALSE(nominalCameraInfo(nominal, named)) << "the user's choice";
   EXPECT_FALSE(distortedCameraInfo(distorted, named)) << "camera_info's D not in use";
   IntrinsicsOverride values;
   values.fx = values.fy = 585;
@@ -268,7 +291,7 @@ TEST(DescribeCamera, SaysTheIntrinsicsTheirSourceAndWhetherTheyAreNominal) {
   const CameraResult given = cameraFor(nominal, 640, 480, values);
   EXPECT_EQ(describeCamera(given.camera, values, topics),
             "fx 585, fy 585, cx 320, cy 240 (640x480) from the parameters fx, fy, cx, cy");
-  EXPECT_FALSE(nominalCameraInfo(given.camera, nominal, values));
+  EXPECT_FALSE(nominalCameraInfo(nominal, values));
 }
 
 Eigen::Isometry3d pose(double rx, double ry, double rz, double x, double y, double z) {
