@@ -121,6 +121,24 @@ inline constexpr double kSecondStartMargin = 1.2;
 // memory apart (under 4 Hz) keep the plain margin.
 inline constexpr double kSecondStartKeptMargin = 2.0;
 inline constexpr double kSecondStartMemory = 0.25;  // s
+// Under those limits a registration whose motion misses the guess by more than
+// kSecondStartCheckSigmas times the guess's usual miss (the root mean square of the camera's
+// recent velocity changes over the interval, VelocityFilter::changeMoment), and by at least
+// kSecondStartCheckTranslation or kSecondStartCheckRotation (grown with the interval as the
+// limits), gets a second start too. There the camera's own acceleration may be the cause, so the
+// guess has no precedence: the second start is kept only where it scores kSecondStartCheckMargin
+// times the first. A person walking at 0.5 m/s pulls the registration 11-19 mm off as it enters
+// the view, under the limits, while the smooth camera's guess misses by about 1 mm (w62's first
+// crossing: 0.0494 -> 0.0026 m/s); a fast hand-held camera's guess misses by 4-9 mm a frame and
+// its threshold follows (the rendered room at 0.8 m/s: 2 second starts in 150 frames, teddy200 1
+// in 193, none kept). With the fixed floors alone (no sigmas) and the plain margin, the
+// untextured room at 0.8 m/s kept second starts that scored within 0.1% of the first, on a flat
+// ridge of the objective, and lost its way (0.0019 -> 0.1377 m/s; docs/accuracy.md,
+// twenty-second round).
+inline constexpr double kSecondStartCheckTranslation = 0.005;  // m
+inline constexpr double kSecondStartCheckRotation = 0.75;      // deg
+inline constexpr double kSecondStartCheckSigmas = 3.0;
+inline constexpr double kSecondStartCheckMargin = 1.1;
 
 // Tracking judgement of a registration, from the solver's result and the motion it implies
 // from the last tracked frame (`frame_motion`; the registration's own transform when the frame
@@ -182,7 +200,9 @@ bool replacesReference(const SolverResult& s, std::size_t points, std::size_t re
 //    or kSecondStartRotation is run again at the finest level from the prior, and that second
 //    start is kept unless the first's kernel value there is kSecondStartMargin times higher
 //    (kSecondStartKeptMargin within kSecondStartMemory of a kept one;
-//    OdometryParams::second_start).
+//    OdometryParams::second_start); one that misses it by less, but unusually for the camera
+//    (kSecondStartCheckSigmas), is run again too and kept only where the second start scores
+//    kSecondStartCheckMargin times higher.
 class Odometry {
  public:
   explicit Odometry(const Params& params = Params());
@@ -279,7 +299,8 @@ class Odometry {
   // Where reg's motion missed `guess` (OdometryParams::second_start, kSecondStartTranslation),
   // the finest level again from the guess, kept unless the first scores kSecondStartMargin
   // times higher (kSecondStartKeptMargin within kSecondStartMemory of the last one kept; `stamp`
-  // is the frame's).
+  // is the frame's); where it missed by less but unusually (kSecondStartCheckSigmas), kept only
+  // where it scores kSecondStartCheckMargin times higher than the first.
   void secondStart(const Tracked& reference, const Eigen::Isometry3d& guess, Registration& reg,
                    OdometryResult& r, double stamp);
   // Whether registrations of this frame move its depth again (sync_depth, a delay, a staged

@@ -198,7 +198,10 @@ struct OdometryParams {
   // kSecondStartMemory of a frame that kept one). A person crossing a third of the view can
   // pull the coarse levels, whose kernel spans both motions, into the person's motion; the
   // finest level's narrow kernel, started from the camera's own predicted motion, holds the
-  // still part (docs/accuracy.md, eighteenth round). Off: the paper's single start.
+  // still part (docs/accuracy.md, eighteenth round). A miss under those limits but unusual for
+  // the camera (kSecondStartCheckSigmas times its recent velocity changes over the interval) is
+  // run again too, kept only where it scores kSecondStartCheckMargin times the first (a person
+  // entering the view of a smooth camera; twenty-second round). Off: the paper's single start.
   bool second_start = true;
 };
 

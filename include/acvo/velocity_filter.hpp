@@ -33,6 +33,9 @@ class VelocityFilter {
   // A frame's final velocity less its coarse levels' (the measurement's error).
   void addCorrection(const Vector6d& correction) { add(correction, correction_, corrections_); }
   void reset() { *this = VelocityFilter(memory_); }
+  // The running second moment of the velocity's change between tracked frames (twists per
+  // second, rotation first): how far a constant-velocity prediction has been missing lately.
+  const Matrix6d& changeMoment() const { return change_; }
 
  private:
   // Running second moments: the mean of the first `memory` samples' outer products, then an

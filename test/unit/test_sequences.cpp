@@ -579,11 +579,71 @@ TEST(Sequences, ASlowPersonStaysOutOfTheOdometryOnceItWasCaughtPulling) {
                 runs[p].rpe.trans.rmse, runs[p].rpe.rot_deg.rmse, runs[p].lost);
     EXPECT_EQ(runs[p].lost, 0);
   }
-  // Measured 0.01003 m/s, 0.2470 deg/s (one frame 9 mm off as the person enters); with the
-  // plain margin after a kept second start 0.610, 8.54, and with one start 0.907, 12.7.
-  EXPECT_LT(runs[0].rpe.trans.rmse, 1.3 * 0.01003);
-  EXPECT_LT(runs[0].rpe.rot_deg.rmse, 1.3 * 0.2470);
+  // Measured 0.00338 m/s, 0.0899 deg/s (0.01003, 0.2470 before the check below the jerk limits
+  // caught the frame 9 mm off as the person enters); with the plain margin after a kept second
+  // start 0.609, 8.53, and with one start 0.907, 12.7.
+  EXPECT_LT(runs[0].rpe.trans.rmse, 1.3 * 0.00338);
+  EXPECT_LT(runs[0].rpe.rot_deg.rmse, 1.3 * 0.0899);
   EXPECT_GT(runs[1].rpe.trans.rmse, 50.0 * runs[0].rpe.trans.rmse);
+}
+
+// The same person's first crossing (w62's frames 0-59). A smooth camera's motion guess misses by
+// about 1 mm a frame; the person, entering, pulls the registration 11-19 mm off, under the jerk
+// limits (kSecondStartTranslation), so only the check against the camera's usual miss
+// (kSecondStartCheckSigmas) runs the second start, which holds the room and scores clearly higher.
+TEST(Sequences, APersonEnteringTheViewIsCaughtUnderTheJerkLimits) {
+  synth::SequenceOptions o;
+  o.frames = 300;  // w62's path, as above
+  o.seed = 62;
+  o.walker_speed = 0.5;
+  const synth::SynthSequence seq(o);
+  const Trajectory all = groundtruthOf(seq);
+  const Trajectory gt(all.begin(), all.begin() + 60);
+  Params one_start;
+  one_start.odometry.second_start = false;
+  const auto runs = runPolicies<2>(
+      {Params(), one_start}, int(gt.size()), [&](int i) { return seq.frame(i).toFrame(); }, gt);
+  for (int p = 0; p < 2; ++p) {
+    std::printf("  %s: RPE %.5f m/s %.4f deg/s, %d lost\n", p == 0 ? "default" : "one start",
+                runs[p].rpe.trans.rmse, runs[p].rpe.rot_deg.rmse, runs[p].lost);
+    EXPECT_EQ(runs[p].lost, 0);
+  }
+  // Measured 0.00259 m/s, 0.0564 deg/s; with the jerk limits alone 0.0494, 1.49; with one start
+  // 0.670, 11.1.
+  EXPECT_LT(runs[0].rpe.trans.rmse, 1.3 * 0.00259);
+  EXPECT_LT(runs[0].rpe.rot_deg.rmse, 1.3 * 0.0564);
+  EXPECT_GT(runs[1].rpe.trans.rmse, 50.0 * runs[0].rpe.trans.rmse);
+}
+
+// A fast hand-held camera's own acceleration makes its motion guess miss by 4-9 mm a frame, and
+// on a room without texture the objective has flat ridges: there a second start ends within 0.1%
+// of the first's score. The check under the jerk limits must neither run on every such frame nor
+// keep those ties (the room at 0.8 m/s, blurred, as scripts/results' fast untextured set: its
+// path over 150 frames, frames 0-59).
+TEST(Sequences, AFastCamerasOwnAccelerationIsNotTakenForAPull) {
+  synth::SequenceOptions o;
+  o.frames = 150;
+  o.texture = false;
+  o.blur = true;
+  o.speed = 0.8;
+  o.seed = 23;
+  const synth::SynthSequence seq(o);
+  const Trajectory all = groundtruthOf(seq);
+  const Trajectory gt(all.begin(), all.begin() + 60);
+  Params one_start;
+  one_start.odometry.second_start = false;
+  const auto runs = runPolicies<2>(
+      {Params(), one_start}, int(gt.size()), [&](int i) { return seq.frame(i).toFrame(); }, gt);
+  for (int p = 0; p < 2; ++p) {
+    std::printf("  %s: RPE %.5f m/s %.4f deg/s, %d lost\n", p == 0 ? "default" : "one start",
+                runs[p].rpe.trans.rmse, runs[p].rpe.rot_deg.rmse, runs[p].lost);
+    EXPECT_EQ(runs[p].lost, 0);
+  }
+  // Measured 0.00145 m/s, 0.0280 deg/s, as with one start; with the floors alone (5 mm, 0.75
+  // deg, no sigmas) and the plain margin (ties kept) 0.00929, 0.0332.
+  EXPECT_LT(runs[0].rpe.trans.rmse, 1.3 * 0.00145);
+  EXPECT_LT(runs[0].rpe.rot_deg.rmse, 1.3 * 0.0280);
+  EXPECT_LT(runs[0].rpe.trans.rmse, 1.05 * runs[1].rpe.trans.rmse);
 }
 
 // A real Kinect's depth errs in blobs of neighbouring pixels (scripts/depth_noise: as a 3-px

@@ -527,12 +527,24 @@ void Odometry::secondStart(const Tracked& reference, const Eigen::Isometry3d& gu
   // Both transforms map into the reference: guess^-1 T is the registered frame motion against
   // the guessed one, from any reference.
   const Eigen::Isometry3d missed = guess.inverse() * reg.solver.transform;
+  const double miss_m = missed.translation().norm(), miss_deg = rotationDeg(missed);
   // A velocity change misses by its acceleration times the interval squared.
   const double frames = r.interval / kSecondStartInterval;
   const double scale = std::max(1.0, frames * frames);
-  if (missed.translation().norm() <= scale * kSecondStartTranslation &&
-      rotationDeg(missed) <= scale * kSecondStartRotation) {
-    return;
+  const bool jerk =
+      miss_m > scale * kSecondStartTranslation || miss_deg > scale * kSecondStartRotation;
+  if (!jerk) {
+    // The guess's usual miss: the camera's velocity changes between the last tracked frames
+    // (their running second moment; twists, rotation first) over this interval.
+    const Matrix6d& change = velocity_filter_.changeMoment();
+    const double usual_m = std::sqrt(change.block<3, 3>(3, 3).trace()) * r.interval;
+    const double usual_deg =
+        std::sqrt(change.block<3, 3>(0, 0).trace()) * r.interval * 180.0 / M_PI;
+    const double check_m =
+        std::max(scale * kSecondStartCheckTranslation, kSecondStartCheckSigmas * usual_m);
+    const double check_deg =
+        std::max(scale * kSecondStartCheckRotation, kSecondStartCheckSigmas * usual_deg);
+    if (miss_m <= check_m && miss_deg <= check_deg) return;
   }
   r.second_start = true;
   SolverResult again;
@@ -542,10 +554,18 @@ void Odometry::secondStart(const Tracked& reference, const Eigen::Isometry3d& gu
   reg.solver.ms_total += again.ms_total;
   reg.solver.ms_neighbours += again.ms_neighbours;
   reg.solver.iterations += again.iterations;
-  const bool pulled_lately = second_start_kept_at_ && stamp >= *second_start_kept_at_ &&
-                            stamp - *second_start_kept_at_ <= kSecondStartMemory;
-  const double margin = pulled_lately ? kSecondStartKeptMargin : kSecondStartMargin;
-  if (failed(again.status) || !(margin * again.objective > reg.solver.objective)) return;
+  if (failed(again.status)) return;
+  if (jerk) {
+    // Beyond what the camera's own acceleration does: the guess's maximum, unless the other
+    // clearly scores higher.
+    const bool pulled_lately = second_start_kept_at_ && stamp >= *second_start_kept_at_ &&
+                               stamp - *second_start_kept_at_ <= kSecondStartMemory;
+    const double margin = pulled_lately ? kSecondStartKeptMargin : kSecondStartMargin;
+    if (!(margin * again.objective > reg.solver.objective)) return;
+  } else if (!(again.objective > kSecondStartCheckMargin * reg.solver.objective)) {
+    // Within it: the guess has no precedence and must clearly score higher.
+    return;
+  }
   r.second_start_kept = true;
   reg.second_start_kept = true;
   again.iterations = reg.solver.iterations;
