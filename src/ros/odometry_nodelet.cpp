@@ -483,6 +483,10 @@ void OdometryNodelet::noteCamera(const acvo::Camera& camera, const Info& info) {
   // Throttled: a topic whose camera_info alternates between two cameras changes on every frame.
   if (nominal) {
     camera_text_ += "; nominal, not a calibration";
+    if (info.binning_x > 1 || info.binning_y > 1 || info.roi.width > 0) {
+      camera_text_ += " (camera_info's own, before binning and its region of interest, at its " +
+                      std::to_string(info.width) + "x" + std::to_string(info.height) + ")";
+    }
     NODELET_WARN_THROTTLE(kCameraNote,
         "camera intrinsics: %s. Equal focal lengths, the principal point at the image's centre "
         "and no distortion are a driver's defaults, not a calibration: exact for a simulated "
