@@ -56,7 +56,8 @@ struct OdometryResult {
   // (that frame became the keyframe).
   bool fell_back_to_previous = false;
   // The registered motion missed the motion guess by more than a hand-held camera's velocity
-  // changes in a frame, so the finest level was run again from the guess (a second start,
+  // changes in a frame, or by less but unusually for this camera (kSecondStartCheckSigmas), so
+  // the finest level was run again from the guess (a second start,
   // OdometryParams::second_start), and whether that result was kept.
   bool second_start = false;
   bool second_start_kept = false;
@@ -125,16 +126,21 @@ inline constexpr double kSecondStartMemory = 0.25;  // s
 // kSecondStartCheckSigmas times the guess's usual miss (the root mean square of the camera's
 // recent velocity changes over the interval, VelocityFilter::changeMoment), and by at least
 // kSecondStartCheckTranslation or kSecondStartCheckRotation (grown with the interval as the
-// limits), gets a second start too. There the camera's own acceleration may be the cause, so the
-// guess has no precedence: the second start is kept only where it scores kSecondStartCheckMargin
-// times the first. A person walking at 0.5 m/s pulls the registration 11-19 mm off as it enters
-// the view, under the limits, while the smooth camera's guess misses by about 1 mm (w62's first
-// crossing: 0.0494 -> 0.0026 m/s); a fast hand-held camera's guess misses by 4-9 mm a frame and
-// its threshold follows (the rendered room at 0.8 m/s: 2 second starts in 150 frames, teddy200 1
-// in 193, none kept). With the fixed floors alone (no sigmas) and the plain margin, the
-// untextured room at 0.8 m/s kept second starts that scored within 0.1% of the first, on a flat
-// ridge of the objective, and lost its way (0.0019 -> 0.1377 m/s; docs/accuracy.md,
-// twenty-second round).
+// limits), gets a second start too; only where the guess is the constant-velocity prediction
+// from a known velocity (not an identity guess, nor one given from outside, whose usual miss is
+// not measured). There the camera's own acceleration may be the cause, so the guess has no
+// precedence: the second start is kept only where it scores kSecondStartCheckMargin times the
+// first (within kSecondStartMemory of a kept one, as above: unless the first scores
+// kSecondStartKeptMargin times higher). A person walking at 0.5 m/s pulls the registration
+// 11-19 mm off as it enters the view, under the limits, while the smooth camera's guess misses
+// by about 1 mm (w62's first crossing: 0.0494 -> 0.0026 m/s); a fast hand-held camera's guess
+// misses by 2-10 mm a frame, 4-7 mm in root mean square, and its threshold follows (the
+// untextured room at 0.8 m/s: 1 second start in 150 frames, as with the limits alone;
+// kitchen7s_dev 2 in 50, teddy200 none; none kept).
+// With the floors alone (no sigmas) and the plain margin, that room kept second starts that
+// scored within 0.1% of the first, on a flat ridge of the objective, and lost its way (0.0019
+// -> 0.1377 m/s; docs/accuracy.md, twenty-second round). A pull that was not caught enters the
+// velocity changes and raises the threshold for the next ten frames or so.
 inline constexpr double kSecondStartCheckTranslation = 0.005;  // m
 inline constexpr double kSecondStartCheckRotation = 0.75;      // deg
 inline constexpr double kSecondStartCheckSigmas = 3.0;
@@ -331,6 +337,9 @@ class Odometry {
   // The stamp of the last tracked frame whose registration kept a second start (none after a
   // lost frame or a reset).
   std::optional<double> second_start_kept_at_;
+  // Whether this frame's guess is the constant-velocity prediction from a known velocity, with
+  // the velocity filter's record of how it missed (the check under the jerk limits needs both).
+  bool guess_predicted_ = false;
   std::uint64_t frames_ = 0;  // frames numbered so far
   ColourDepthCheck colour_check_;
   // Each frame's colour is resampled by it (colourResampling), and by the verdict's baseline with

@@ -36,6 +36,7 @@ class VelocityFilter {
   // The running second moment of the velocity's change between tracked frames (twists per
   // second, rotation first): how far a constant-velocity prediction has been missing lately.
   const Matrix6d& changeMoment() const { return change_; }
+  int changes() const { return changes_; }  // the samples it has seen since the last reset
 
  private:
   // Running second moments: the mean of the first `memory` samples' outer products, then an

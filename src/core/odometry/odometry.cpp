@@ -379,6 +379,9 @@ OdometryResult Odometry::track(const Frame& frame,
     return r;
   }
   r.interval = frame.stamp - last_->cloud->cloud.stamp;
+  guess_predicted_ = !motion_guess &&
+                     params_.odometry.initial_guess == InitialGuess::kConstantVelocity &&
+                     lastVelocity() && velocity_filter_.changes() > 0;
   const Eigen::Isometry3d prior =
       motion_guess ? *motion_guess
       : params_.odometry.initial_guess == InitialGuess::kConstantVelocity
@@ -534,8 +537,12 @@ void Odometry::secondStart(const Tracked& reference, const Eigen::Isometry3d& gu
   const bool jerk =
       miss_m > scale * kSecondStartTranslation || miss_deg > scale * kSecondStartRotation;
   if (!jerk) {
-    // The guess's usual miss: the camera's velocity changes between the last tracked frames
-    // (their running second moment; twists, rotation first) over this interval.
+    // The guess's usual miss, where the guess is a constant-velocity prediction: the camera's
+    // velocity changes between the last tracked frames (their running second moment; twists,
+    // rotation first) over this interval. An identity guess or one given from outside has no
+    // such measure. The sigmas grow with the interval, the floors with its square (a frame
+    // dropped: the guess misses by the velocity times the interval's excess).
+    if (!guess_predicted_) return;
     const Matrix6d& change = velocity_filter_.changeMoment();
     const double usual_m = std::sqrt(change.block<3, 3>(3, 3).trace()) * r.interval;
     const double usual_deg =
@@ -555,11 +562,11 @@ void Odometry::secondStart(const Tracked& reference, const Eigen::Isometry3d& gu
   reg.solver.ms_neighbours += again.ms_neighbours;
   reg.solver.iterations += again.iterations;
   if (failed(again.status)) return;
-  if (jerk) {
-    // Beyond what the camera's own acceleration does: the guess's maximum, unless the other
-    // clearly scores higher.
-    const bool pulled_lately = second_start_kept_at_ && stamp >= *second_start_kept_at_ &&
-                               stamp - *second_start_kept_at_ <= kSecondStartMemory;
+  const bool pulled_lately = second_start_kept_at_ && stamp >= *second_start_kept_at_ &&
+                             stamp - *second_start_kept_at_ <= kSecondStartMemory;
+  if (jerk || pulled_lately) {
+    // Beyond what the camera's own acceleration does, or soon after something pulled: the
+    // guess's maximum, unless the other clearly scores higher.
     const double margin = pulled_lately ? kSecondStartKeptMargin : kSecondStartMargin;
     if (!(margin * again.objective > reg.solver.objective)) return;
   } else if (!(again.objective > kSecondStartCheckMargin * reg.solver.objective)) {
