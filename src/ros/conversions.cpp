@@ -33,6 +33,12 @@ cv::Mat view(const sensor_msgs::Image& msg, int cv_type) {
                  const_cast<std::uint8_t*>(msg.data.data()), msg.step);
 }
 
+// Whether camera_info's projection matrix P is filled; a driver that fills K alone leaves it all
+// zero, and K is read instead.
+bool hasProjection(const sensor_msgs::CameraInfo& info) {
+  return info.P[0] != 0.0 || info.P[5] != 0.0;
+}
+
 }  // namespace
 
 std::string stripSlash(const std::string& frame_id) {
@@ -184,7 +190,7 @@ CameraResult cameraFor(const sensor_msgs::CameraInfo& info, int width, int heigh
       return out;
     }
     // A driver that fills K alone (P all zero): K, adjusted alike.
-    const bool has_p = info.P[0] != 0.0 || info.P[5] != 0.0;
+    const bool has_p = hasProjection(info);
     const cv::Matx33d k = has_p ? model.projectionMatrix().get_minor<3, 3>(0, 0)
                                 : model.intrinsicMatrix();
     cam.fx = k(0, 0);
@@ -229,7 +235,7 @@ bool nominalCameraInfo(const sensor_msgs::CameraInfo& info, const IntrinsicsOver
   if (!source.fromCameraInfo() || distortedCameraInfo(info, source)) return false;
   // The full sensor's intrinsics, before binning and a region of interest (P, or K where P is all
   // zero, as cameraFor reads them): a driver's defaults are about that image's centre.
-  const bool has_p = info.P[0] != 0.0 || info.P[5] != 0.0;
+  const bool has_p = hasProjection(info);
   acvo::Camera full;
   full.fx = has_p ? info.P[0] : info.K[0];
   full.fy = has_p ? info.P[5] : info.K[4];

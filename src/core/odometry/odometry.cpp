@@ -379,14 +379,13 @@ OdometryResult Odometry::track(const Frame& frame,
     return r;
   }
   r.interval = frame.stamp - last_->cloud->cloud.stamp;
-  guess_predicted_ = !motion_guess &&
-                     params_.odometry.initial_guess == InitialGuess::kConstantVelocity &&
-                     lastVelocity() && velocity_filter_.changes() > 0;
+  const bool constant_velocity =
+      !motion_guess && params_.odometry.initial_guess == InitialGuess::kConstantVelocity;
   const Eigen::Isometry3d prior =
-      motion_guess ? *motion_guess
-      : params_.odometry.initial_guess == InitialGuess::kConstantVelocity
-          ? motionPrior(velocity_, velocity_interval_, r.interval)
-          : Eigen::Isometry3d::Identity();
+      motion_guess        ? *motion_guess
+      : constant_velocity ? motionPrior(velocity_, velocity_interval_, r.interval)
+                          : Eigen::Isometry3d::Identity();
+  guess_predicted_ = constant_velocity && lastVelocity() && velocity_filter_.changes() > 0;
   Registration reg = registerFrame(r, frame, current, prior);
   // A lost frame's motion moves no depth: its cloud is kept as built (it may become the
   // reference).
