@@ -145,6 +145,20 @@ inline constexpr double kSecondStartCheckTranslation = 0.005;  // m
 inline constexpr double kSecondStartCheckRotation = 0.75;      // deg
 inline constexpr double kSecondStartCheckSigmas = 3.0;
 inline constexpr double kSecondStartCheckMargin = 1.1;
+// Where no velocity is known yet (the first registered frame, or the first after a lost one),
+// the guess cannot hold the registration to the camera's motion, and something large moving in
+// view can take it along from the start (a person crossing 1.2 m in front of a camera at
+// 0.4 m/s: every frame 55 mm off until the person left). Where more than kRestFraction of the
+// registered points disagree with the reference under the motion found (agreement.hpp), those
+// points alone are registered from the guess, and the whole cloud is refined at the finest level
+// from their motion: a second start from the rest of the points. It is kept where the image's
+// pixels agree with it kRestMargin times as often as with the first (denseAgreement): the
+// camera's motion is the one most of the view agrees with, whatever the selection chose. That
+// person: 2730 pixels agree with the first start, 3128 with the rest's; 0.1413 -> 0.0013 m/s
+// (docs/accuracy.md, twenty-third round). A kept one starts kSecondStartMemory as any kept
+// second start does (without: a person at 1 m/s taken again from frame 3 to 8, 11 mm a frame).
+inline constexpr double kRestFraction = 0.1;
+inline constexpr double kRestMargin = 1.1;
 
 // Tracking judgement of a registration, from the solver's result and the motion it implies
 // from the last tracked frame (`frame_motion`; the registration's own transform when the frame
@@ -208,7 +222,8 @@ bool replacesReference(const SolverResult& s, std::size_t points, std::size_t re
 //    (kSecondStartKeptMargin within kSecondStartMemory of a kept one;
 //    OdometryParams::second_start); one that misses it by less, but unusually for the camera
 //    (kSecondStartCheckSigmas), is run again too and kept only where the second start scores
-//    kSecondStartCheckMargin times higher.
+//    kSecondStartCheckMargin times higher. Where no velocity is known yet, a registration that
+//    leaves many points unexplained is run again from those points (kRestFraction, kRestMargin).
 class Odometry {
  public:
   explicit Odometry(const Params& params = Params());
@@ -307,6 +322,11 @@ class Odometry {
   // times higher (kSecondStartKeptMargin within kSecondStartMemory of the last one kept; `stamp`
   // is the frame's); where it missed by less but unusually (kSecondStartCheckSigmas), kept only
   // where it scores kSecondStartCheckMargin times higher than the first.
+  // The second start from the rest of the points, where no velocity is known (kRestFraction).
+  void restStart(const Tracked& reference, const Eigen::Isometry3d& guess, Registration& reg,
+                 OdometryResult& r);
+  // A second start replaces the first: `again`, with the cost of both (addStartCost).
+  void keepSecondStart(Registration& reg, OdometryResult& r, SolverResult again);
   void secondStart(const Tracked& reference, const Eigen::Isometry3d& guess, Registration& reg,
                    OdometryResult& r, double stamp);
   // Whether registrations of this frame move its depth again (sync_depth, a delay, a staged
@@ -340,6 +360,8 @@ class Odometry {
   // Whether this frame's guess is the constant-velocity prediction from a known velocity, with
   // the velocity filter's record of how it missed (the check under the jerk limits needs both).
   bool guess_predicted_ = false;
+  // Whether this frame's guess is the constant-velocity one while no velocity is known.
+  bool guess_unknown_ = false;
   std::uint64_t frames_ = 0;  // frames numbered so far
   ColourDepthCheck colour_check_;
   // Each frame's colour is resampled by it (colourResampling), and by the verdict's baseline with

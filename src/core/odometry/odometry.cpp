@@ -9,6 +9,7 @@
 
 #include <tbb/task_arena.h>
 
+#include "acvo/agreement.hpp"
 #include "acvo/covariance.hpp"
 #include "acvo/depth.hpp"
 
@@ -98,6 +99,14 @@ Eigen::Isometry3d atConstantVelocity(const Eigen::Isometry3d& motion, double mea
 
 double rotationDeg(const Eigen::Isometry3d& T) {
   return logSE3(T).head<3>().norm() * 180.0 / M_PI;
+}
+
+// A second start's cost added to the first's: the frame's cost is both starts', whichever is kept
+// (Odometry::keepSecondStart).
+void addStartCost(SolverResult& first, const SolverResult& again) {
+  first.ms_total += again.ms_total;
+  first.ms_neighbours += again.ms_neighbours;
+  first.iterations += again.iterations;
 }
 
 // The solver gave no registration: too few points, or numbers that are not finite.
@@ -256,7 +265,10 @@ Odometry::Registration Odometry::registerTo(const Tracked& reference,
         coarse, engine_->align(*reference.cloud, *reg.moving, coarse.transform,
                                AlignStages::kFinest));
   });
-  if (params_.odometry.second_start) secondStart(reference, guess, reg, r, frame.stamp);
+  if (params_.odometry.second_start) {
+    if (guess_unknown_) restStart(reference, guess, reg, r);
+    secondStart(reference, guess, reg, r, frame.stamp);
+  }
   reg.judgement = judgeTracking(reg.solver, frameMotion(reg.solver.transform), params_.odometry);
   const SolverResult& s = reg.solver;
   if (failed(s.status)) {
@@ -386,6 +398,7 @@ OdometryResult Odometry::track(const Frame& frame,
       : constant_velocity ? motionPrior(velocity_, velocity_interval_, r.interval)
                           : Eigen::Isometry3d::Identity();
   guess_predicted_ = constant_velocity && lastVelocity() && velocity_filter_.changes() > 0;
+  guess_unknown_ = constant_velocity && !lastVelocity();
   Registration reg = registerFrame(r, frame, current, prior);
   // A lost frame's motion moves no depth: its cloud is kept as built (it may become the
   // reference).
@@ -523,6 +536,46 @@ void Odometry::start(OdometryResult& r, const std::shared_ptr<PreparedCloud>& re
   r.new_keyframe = true;
 }
 
+void Odometry::restStart(const Tracked& reference, const Eigen::Isometry3d& guess,
+                         Registration& reg, OdometryResult& r) {
+  if (failed(reg.solver.status)) return;
+  const LabelledCloud& fixed = reference.cloud->cloud;
+  const LabelledCloud& moving = reg.moving->cloud;
+  LabelledCloud rest = disagreeingPoints(fixed, moving, reg.solver.transform);
+  if (!(double(rest.size()) > kRestFraction * double(moving.size())) ||
+      int(rest.size()) < engine_->minPoints()) {
+    return;
+  }
+  r.second_start = true;
+  SolverResult again;
+  arena_->arena.execute([&] {
+    const std::shared_ptr<PreparedCloud> alone = engine_->prepare(std::move(rest), false);
+    const SolverResult theirs = engine_->align(*reference.cloud, *alone, guess);
+    if (failed(theirs.status)) {
+      again = theirs;
+      return;
+    }
+    again = combinedStages(theirs, engine_->align(*reference.cloud, *reg.moving,
+                                                  theirs.transform, AlignStages::kFinest));
+  });
+  addStartCost(reg.solver, again);
+  if (failed(again.status) ||
+      !(denseAgreement(fixed, moving, again.transform) >
+        kRestMargin * denseAgreement(fixed, moving, reg.solver.transform))) {
+    return;
+  }
+  keepSecondStart(reg, r, std::move(again));
+}
+
+void Odometry::keepSecondStart(Registration& reg, OdometryResult& r, SolverResult again) {
+  r.second_start_kept = true;
+  reg.second_start_kept = true;
+  again.iterations = reg.solver.iterations;
+  again.ms_total = reg.solver.ms_total;
+  again.ms_neighbours = reg.solver.ms_neighbours;
+  reg.solver = std::move(again);
+}
+
 void Odometry::secondStart(const Tracked& reference, const Eigen::Isometry3d& guess,
                            Registration& reg, OdometryResult& r, double stamp) {
   if (failed(reg.solver.status)) return;
@@ -556,10 +609,7 @@ void Odometry::secondStart(const Tracked& reference, const Eigen::Isometry3d& gu
   SolverResult again;
   arena_->arena.execute(
       [&] { again = engine_->align(*reference.cloud, *reg.moving, guess, AlignStages::kFinest); });
-  // The frame's cost is both starts', whichever is kept.
-  reg.solver.ms_total += again.ms_total;
-  reg.solver.ms_neighbours += again.ms_neighbours;
-  reg.solver.iterations += again.iterations;
+  addStartCost(reg.solver, again);
   if (failed(again.status)) return;
   const bool pulled_lately = second_start_kept_at_ && stamp >= *second_start_kept_at_ &&
                              stamp - *second_start_kept_at_ <= kSecondStartMemory;
@@ -572,12 +622,7 @@ void Odometry::secondStart(const Tracked& reference, const Eigen::Isometry3d& gu
     // Within it: the guess has no precedence and must clearly score higher.
     return;
   }
-  r.second_start_kept = true;
-  reg.second_start_kept = true;
-  again.iterations = reg.solver.iterations;
-  again.ms_total = reg.solver.ms_total;
-  again.ms_neighbours = reg.solver.ms_neighbours;
-  reg.solver = std::move(again);
+  keepSecondStart(reg, r, std::move(again));
 }
 
 Odometry::Registration Odometry::registerFrame(OdometryResult& r, const Frame& frame,
