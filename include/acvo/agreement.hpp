@@ -23,7 +23,7 @@ inline constexpr int kAgreementStride = 8;
 
 // The points of `moving` that land on a reference pixel with depth under `to_reference`
 // (moving -> reference) and disagree with it there; its images and camera are `moving`'s.
-// Empty where either cloud has no images.
+// Empty where either cloud has no images, or `moving` no pixel for each point.
 LabelledCloud disagreeingPoints(const LabelledCloud& reference, const LabelledCloud& moving,
                                 const Eigen::Isometry3d& to_reference);
 

@@ -66,4 +66,7 @@ LabelledCloud withDepth(const LabelledCloud& cloud, const cv::Mat& depth_m,
 // order, so a share keeps the selection's spread over the image.
 LabelledCloud everyNth(const LabelledCloud& cloud, double step);
 
+// A cloud with `cloud`'s images, camera, stamp and motions and room for `count` points, none yet.
+LabelledCloud withoutPoints(const LabelledCloud& cloud, std::size_t count);
+
 }  // namespace acvo

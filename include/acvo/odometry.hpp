@@ -58,7 +58,8 @@ struct OdometryResult {
   // The registered motion missed the motion guess by more than a hand-held camera's velocity
   // changes in a frame, or by less but unusually for this camera (kSecondStartCheckSigmas), so
   // the finest level was run again from the guess (a second start,
-  // OdometryParams::second_start), and whether that result was kept.
+  // OdometryParams::second_start); or no motion was known yet and the points the registration
+  // left disagreeing were registered alone (kRestFraction). And whether that result was kept.
   bool second_start = false;
   bool second_start_kept = false;
   std::shared_ptr<const LabelledCloud> cloud;  // this frame's cloud (null for a bad frame)
@@ -317,16 +318,17 @@ class Odometry {
   // instant than the colour (retimes), in two stages with the depth moved again in between.
   Registration registerTo(const Tracked& reference, const std::shared_ptr<PreparedCloud>& current,
                           const Eigen::Isometry3d& guess, const Frame& frame, OdometryResult& r);
+  // The second start from the rest of the points, where no motion is known (kRestFraction);
+  // returns whether it was kept.
+  bool restStart(const Tracked& reference, const Eigen::Isometry3d& guess, Registration& reg,
+                 OdometryResult& r);
+  // A second start replaces the first: `again`, with the cost of both (addStartCost).
+  void keepSecondStart(Registration& reg, OdometryResult& r, SolverResult again);
   // Where reg's motion missed `guess` (OdometryParams::second_start, kSecondStartTranslation),
   // the finest level again from the guess, kept unless the first scores kSecondStartMargin
   // times higher (kSecondStartKeptMargin within kSecondStartMemory of the last one kept; `stamp`
   // is the frame's); where it missed by less but unusually (kSecondStartCheckSigmas), kept only
   // where it scores kSecondStartCheckMargin times higher than the first.
-  // The second start from the rest of the points, where no velocity is known (kRestFraction).
-  void restStart(const Tracked& reference, const Eigen::Isometry3d& guess, Registration& reg,
-                 OdometryResult& r);
-  // A second start replaces the first: `again`, with the cost of both (addStartCost).
-  void keepSecondStart(Registration& reg, OdometryResult& r, SolverResult again);
   void secondStart(const Tracked& reference, const Eigen::Isometry3d& guess, Registration& reg,
                    OdometryResult& r, double stamp);
   // Whether registrations of this frame move its depth again (sync_depth, a delay, a staged
@@ -360,7 +362,10 @@ class Odometry {
   // Whether this frame's guess is the constant-velocity prediction from a known velocity, with
   // the velocity filter's record of how it missed (the check under the jerk limits needs both).
   bool guess_predicted_ = false;
-  // Whether this frame's guess is the constant-velocity one while no velocity is known.
+  // Whether a frame was tracked since the start, the last reset or the last lost frame: until
+  // then the constant-velocity guess is the identity, no motion measured.
+  bool motion_known_ = false;
+  // Whether this frame's guess is the constant-velocity one while no motion is known.
   bool guess_unknown_ = false;
   std::uint64_t frames_ = 0;  // frames numbered so far
   ColourDepthCheck colour_check_;

@@ -201,7 +201,11 @@ struct OdometryParams {
   // still part (docs/accuracy.md, eighteenth round). A miss under those limits but unusual for
   // the camera (kSecondStartCheckSigmas times its recent velocity changes over the interval) is
   // run again too, kept only where it scores kSecondStartCheckMargin times the first (a person
-  // entering the view of a smooth camera; twenty-second round). Off: the paper's single start.
+  // entering the view of a smooth camera; twenty-second round). Where no motion is known yet
+  // (the first frame, the first after a lost one) and over kRestFraction of the points disagree
+  // with the reference, those points are registered alone, and that result is kept where
+  // kRestMargin times as many of the image's pixels agree with it (a person in view from the
+  // start; twenty-third round). Off: the paper's single start.
   bool second_start = true;
 };
 

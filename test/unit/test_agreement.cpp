@@ -61,11 +61,17 @@ TEST(Agreement, ACrossingPersonsPointsDisagreeUnderTheCamerasMotion) {
   EXPECT_GT(with_person, 5 * room);
 }
 
-TEST(Agreement, CloudsWithoutImagesAgreeNowhere) {
+TEST(Agreement, CloudsWithoutImagesOrPixelsAgreeNowhere) {
   TwoFrames f = twoFrames();
+  Eigen::Isometry3d shifted = f.to_reference;
+  shifted.translation().x() += 0.05;
+  ASSERT_FALSE(disagreeingPoints(f.reference, f.moving, shifted).empty());
+  LabelledCloud no_pixels = f.moving;
+  no_pixels.pixels.clear();  // a cloud made of points alone, its images attached
+  EXPECT_TRUE(disagreeingPoints(f.reference, no_pixels, shifted).empty());
   f.reference.depth = cv::Mat();
   EXPECT_EQ(denseAgreement(f.reference, f.moving, f.to_reference), 0);
-  EXPECT_TRUE(disagreeingPoints(f.reference, f.moving, f.to_reference).empty());
+  EXPECT_TRUE(disagreeingPoints(f.reference, f.moving, shifted).empty());
 }
 
 }  // namespace

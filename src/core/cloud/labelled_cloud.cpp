@@ -86,8 +86,6 @@ LabelledCloud buildLabelledCloud(const Frame& frame, const SelectionParams& para
   return cloud;
 }
 
-namespace {
-// A cloud with `cloud`'s images, camera, stamp and motions and room for `count` points, none yet.
 LabelledCloud withoutPoints(const LabelledCloud& cloud, std::size_t count) {
   LabelledCloud out;
   out.stamp = cloud.stamp;
@@ -104,7 +102,6 @@ LabelledCloud withoutPoints(const LabelledCloud& cloud, std::size_t count) {
   out.rgb.reserve(count);
   return out;
 }
-}  // namespace
 
 LabelledCloud withDepth(const LabelledCloud& cloud, const cv::Mat& depth_m,
                         const SelectionParams& params) {

@@ -33,13 +33,14 @@ bool landsOn(const LabelledCloud& reference, const Eigen::Vector3d& y, int grey,
 
 LabelledCloud disagreeingPoints(const LabelledCloud& reference, const LabelledCloud& moving,
                                 const Eigen::Isometry3d& to_reference) {
-  LabelledCloud out = moving;
-  out.points.clear();
-  out.labels.clear();
-  out.pixels.clear();
-  out.rgb.clear();
-  if (!hasImages(reference) || !hasImages(moving)) return out;
-  for (std::size_t i = 0; i < moving.size(); ++i) {
+  LabelledCloud out = withoutPoints(moving, 0);
+  // A cloud made of points alone has no pixels to read its grey levels at.
+  const std::size_t n = moving.size();
+  if (!hasImages(reference) || !hasImages(moving) || moving.pixels.size() != n ||
+      moving.labels.size() != n || moving.rgb.size() != n) {
+    return out;
+  }
+  for (std::size_t i = 0; i < n; ++i) {
     const cv::Point& p = moving.pixels[i];
     bool agrees = false;
     if (!landsOn(reference, to_reference * moving.points[i].cast<double>(),

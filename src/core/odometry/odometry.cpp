@@ -37,7 +37,8 @@ struct Odometry::Registration {
   Judgement judgement;
   Matrix6d covariance = lostCovariance();  // of the motion, when tracked
   std::size_t fixed_points = 0;
-  bool second_start_kept = false;  // secondStart's result replaced the first start's
+  // A second start's result (restStart's or secondStart's) replaced the first start's.
+  bool second_start_kept = false;
 };
 
 std::string toString(Tracking t) {
@@ -200,6 +201,7 @@ void Odometry::reset(const Eigen::Isometry3d& pose, const Matrix6d& covariance) 
   pose_covariance_ = covariance;
   velocity_ = Eigen::Isometry3d::Identity();
   velocity_interval_ = 0.0;
+  motion_known_ = false;
   velocity_filter_.reset();
   keyframe_.reset();
   last_.reset();
@@ -265,8 +267,10 @@ Odometry::Registration Odometry::registerTo(const Tracked& reference,
         coarse, engine_->align(*reference.cloud, *reg.moving, coarse.transform,
                                AlignStages::kFinest));
   });
-  if (params_.odometry.second_start) {
-    if (guess_unknown_) restStart(reference, guess, reg, r);
+  // A kept start from the rest of the points has already chosen between two maxima by the
+  // image's agreement, which the kernel value secondStart compares cannot tell apart there.
+  if (params_.odometry.second_start &&
+      !(guess_unknown_ && restStart(reference, guess, reg, r))) {
     secondStart(reference, guess, reg, r, frame.stamp);
   }
   reg.judgement = judgeTracking(reg.solver, frameMotion(reg.solver.transform), params_.odometry);
@@ -398,7 +402,7 @@ OdometryResult Odometry::track(const Frame& frame,
       : constant_velocity ? motionPrior(velocity_, velocity_interval_, r.interval)
                           : Eigen::Isometry3d::Identity();
   guess_predicted_ = constant_velocity && lastVelocity() && velocity_filter_.changes() > 0;
-  guess_unknown_ = constant_velocity && !lastVelocity();
+  guess_unknown_ = constant_velocity && !motion_known_;
   Registration reg = registerFrame(r, frame, current, prior);
   // A lost frame's motion moves no depth: its cloud is kept as built (it may become the
   // reference).
@@ -536,15 +540,16 @@ void Odometry::start(OdometryResult& r, const std::shared_ptr<PreparedCloud>& re
   r.new_keyframe = true;
 }
 
-void Odometry::restStart(const Tracked& reference, const Eigen::Isometry3d& guess,
+bool Odometry::restStart(const Tracked& reference, const Eigen::Isometry3d& guess,
                          Registration& reg, OdometryResult& r) {
-  if (failed(reg.solver.status)) return;
+  if (failed(reg.solver.status)) return false;
+  const auto t0 = std::chrono::steady_clock::now();
   const LabelledCloud& fixed = reference.cloud->cloud;
   const LabelledCloud& moving = reg.moving->cloud;
   LabelledCloud rest = disagreeingPoints(fixed, moving, reg.solver.transform);
   if (!(double(rest.size()) > kRestFraction * double(moving.size())) ||
       int(rest.size()) < engine_->minPoints()) {
-    return;
+    return false;
   }
   r.second_start = true;
   SolverResult again;
@@ -558,13 +563,17 @@ void Odometry::restStart(const Tracked& reference, const Eigen::Isometry3d& gues
     again = combinedStages(theirs, engine_->align(*reference.cloud, *reg.moving,
                                                   theirs.transform, AlignStages::kFinest));
   });
+  const bool keep = !failed(again.status) &&
+                    denseAgreement(fixed, moving, again.transform) >
+                        kRestMargin * denseAgreement(fixed, moving, reg.solver.transform);
+  // The registrations' own times, and the sorting, preparing and counting around them.
+  const double ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  again.ms_total = std::max(again.ms_total, ms);
   addStartCost(reg.solver, again);
-  if (failed(again.status) ||
-      !(denseAgreement(fixed, moving, again.transform) >
-        kRestMargin * denseAgreement(fixed, moving, reg.solver.transform))) {
-    return;
-  }
+  if (!keep) return false;
   keepSecondStart(reg, r, std::move(again));
+  return true;
 }
 
 void Odometry::keepSecondStart(Registration& reg, OdometryResult& r, SolverResult again) {
@@ -682,6 +691,7 @@ void Odometry::tracked(OdometryResult& r, const Registration& reg,
   }
   velocity_ = r.motion;
   velocity_interval_ = r.interval;
+  motion_known_ = true;
   lost_in_a_row_ = 0;
 
   Tracked frame{current, r.frame_index, pose_, pose_covariance_, to_keyframe, reg.covariance};
@@ -701,6 +711,7 @@ void Odometry::lost(OdometryResult& r, const Registration& reg,
   // Keep the last good pose; never extrapolate a motion we could not confirm.
   velocity_ = Eigen::Isometry3d::Identity();
   velocity_interval_ = 0.0;
+  motion_known_ = false;
   r.motion = Eigen::Isometry3d::Identity();
   ++lost_in_a_row_;
   r.pose = pose_;
