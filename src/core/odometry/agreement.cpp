@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <optional>
 
 namespace acvo {
 namespace {
@@ -12,21 +13,20 @@ bool hasImages(const LabelledCloud& cloud) {
 }
 
 // Whether a point `y` of the reference's frame, of grey level `grey`, agrees with the reference
-// image where it lands; false where it lands off the image or on no depth.
-bool landsOn(const LabelledCloud& reference, const Eigen::Vector3d& y, int grey, bool& agrees) {
-  if (!(y.z() > 0.0)) return false;
-  const Camera& c = reference.camera;
-  const double u = std::round(c.fx * y.x() / y.z() + c.cx);
-  const double v = std::round(c.fy * y.y() / y.z() + c.cy);
+// image where it lands; none where it lands off the image or on no depth.
+std::optional<bool> agreesWhereItLands(const LabelledCloud& reference, const Eigen::Vector3d& y,
+                                       int grey) {
+  if (!(y.z() > 0.0)) return std::nullopt;
+  const Eigen::Vector2d pixel = reference.camera.project(y);
+  const double u = std::round(pixel.x()), v = std::round(pixel.y());
   if (!(u >= 0.0 && v >= 0.0 && u < reference.depth.cols && v < reference.depth.rows)) {
-    return false;
+    return std::nullopt;
   }
   const float z = reference.depth.at<float>(int(v), int(u));
-  if (!(z > 0.0f) || !std::isfinite(z)) return false;
-  agrees = std::abs(double(z) - y.z()) <
-               kAgreementDepth + kAgreementDepthQuadratic * y.z() * y.z() &&
-           std::abs(int(reference.gray.at<std::uint8_t>(int(v), int(u))) - grey) < kAgreementGrey;
-  return true;
+  if (!(z > 0.0f) || !std::isfinite(z)) return std::nullopt;
+  return std::abs(double(z) - y.z()) <
+             kAgreementDepth + kAgreementDepthQuadratic * y.z() * y.z() &&
+         std::abs(int(reference.gray.at<std::uint8_t>(int(v), int(u))) - grey) < kAgreementGrey;
 }
 
 }  // namespace
@@ -42,12 +42,10 @@ LabelledCloud disagreeingPoints(const LabelledCloud& reference, const LabelledCl
   }
   for (std::size_t i = 0; i < n; ++i) {
     const cv::Point& p = moving.pixels[i];
-    bool agrees = false;
-    if (!landsOn(reference, to_reference * moving.points[i].cast<double>(),
-                 moving.gray.at<std::uint8_t>(p.y, p.x), agrees) ||
-        agrees) {
-      continue;
-    }
+    const std::optional<bool> agrees =
+        agreesWhereItLands(reference, to_reference * moving.points[i].cast<double>(),
+                           moving.gray.at<std::uint8_t>(p.y, p.x));
+    if (!agrees || *agrees) continue;
     out.points.push_back(moving.points[i]);
     out.labels.push_back(moving.labels[i]);
     out.pixels.push_back(p);
@@ -65,12 +63,10 @@ int denseAgreement(const LabelledCloud& reference, const LabelledCloud& moving,
     for (int u = s / 2; u < moving.depth.cols; u += s) {
       const float z = moving.depth.at<float>(v, u);
       if (!(z > 0.0f) || !std::isfinite(z)) continue;
-      bool agrees = false;
-      if (landsOn(reference, to_reference * moving.camera.backProject(u, v, z),
-                  moving.gray.at<std::uint8_t>(v, u), agrees) &&
-          agrees) {
-        ++count;
-      }
+      const std::optional<bool> agrees =
+          agreesWhereItLands(reference, to_reference * moving.camera.backProject(u, v, z),
+                             moving.gray.at<std::uint8_t>(v, u));
+      if (agrees.value_or(false)) ++count;
     }
   }
   return count;

@@ -102,6 +102,11 @@ double rotationDeg(const Eigen::Isometry3d& T) {
   return logSE3(T).head<3>().norm() * 180.0 / M_PI;
 }
 
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
 // A second start's cost added to the first's: the frame's cost is both starts', whichever is kept
 // (Odometry::keepSecondStart).
 void addStartCost(SolverResult& first, const SolverResult& again) {
@@ -458,7 +463,7 @@ std::shared_ptr<PreparedCloud> Odometry::retimedCloud(const PreparedCloud& curre
                                                       const Frame& frame,
                                                       const Vector6d& velocity,
                                                       OdometryResult& r, cv::Mat* depth) const {
-  const auto t0 = std::chrono::steady_clock::now();
+  const auto t0 = Clock::now();
   // What the cloud was built with: the last frame-to-frame motion over the delay, or nothing.
   const Eigen::Isometry3d before =
       r.depth_synced ? motionOver(r.depth_delay).value_or(Eigen::Isometry3d::Identity())
@@ -473,13 +478,11 @@ std::shared_ptr<PreparedCloud> Odometry::retimedCloud(const PreparedCloud& curre
   *depth = depthSeenFrom(frame.depth, frame.camera, moved);
   LabelledCloud cloud = withDepth(current.cloud, *depth, params_.selection);
   auto out = engine_->prepare(std::move(cloud), current.reference);
-  r.ms_cloud += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
-                    .count();
+  r.ms_cloud += msSince(t0);
   return out;
 }
 
 std::shared_ptr<PreparedCloud> Odometry::buildCloud(const Frame& frame, OdometryResult& r) {
-  using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
   std::shared_ptr<PreparedCloud> current;
   // Frame to frame, every frame becomes the reference: its search grids are built with it.
@@ -505,7 +508,7 @@ std::shared_ptr<PreparedCloud> Odometry::buildCloud(const Frame& frame, Odometry
     // A share's search grids would not be used: the whole selection becomes the reference.
     current = engine_->prepare(std::move(cloud), every_frame_a_reference && !selected_);
   });
-  r.ms_cloud = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+  r.ms_cloud = msSince(t0);
   r.moving_points = current->size();
   r.ms_prepare = current->ms_prepare;
   r.cloud = std::shared_ptr<const LabelledCloud>(current, &current->cloud);
@@ -516,13 +519,12 @@ std::shared_ptr<PreparedCloud> Odometry::asReferenceCloud(
     OdometryResult& r, const std::shared_ptr<PreparedCloud>& registered, const cv::Mat& depth) {
   std::shared_ptr<PreparedCloud> cloud = registered;
   if (selected_) {
-    const auto t0 = std::chrono::steady_clock::now();
+    const auto t0 = Clock::now();
     LabelledCloud all = depth.empty() ? std::move(*selected_)
                                       : withDepth(*selected_, depth, params_.selection);
     selected_.reset();
     arena_->arena.execute([&] { cloud = engine_->prepare(std::move(all), false); });
-    const double ms =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    const double ms = msSince(t0);
     r.ms_prepare += ms;
     r.ms_cloud += ms;
   }
@@ -543,7 +545,7 @@ void Odometry::start(OdometryResult& r, const std::shared_ptr<PreparedCloud>& re
 bool Odometry::restStart(const Tracked& reference, const Eigen::Isometry3d& guess,
                          Registration& reg, OdometryResult& r) {
   if (failed(reg.solver.status)) return false;
-  const auto t0 = std::chrono::steady_clock::now();
+  const auto t0 = Clock::now();
   const LabelledCloud& fixed = reference.cloud->cloud;
   const LabelledCloud& moving = reg.moving->cloud;
   LabelledCloud rest = disagreeingPoints(fixed, moving, reg.solver.transform);
@@ -567,9 +569,7 @@ bool Odometry::restStart(const Tracked& reference, const Eigen::Isometry3d& gues
                     denseAgreement(fixed, moving, again.transform) >
                         kRestMargin * denseAgreement(fixed, moving, reg.solver.transform);
   // The registrations' own times, and the sorting, preparing and counting around them.
-  const double ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  again.ms_total = std::max(again.ms_total, ms);
+  again.ms_total = std::max(again.ms_total, msSince(t0));
   addStartCost(reg.solver, again);
   if (!keep) return false;
   keepSecondStart(reg, r, std::move(again));
