@@ -7,24 +7,30 @@
 //
 // The evidence: where the depth jumps (an object's silhouette) the colour nearly always changes
 // too. Per frame, the colour image's gradient magnitude (Sobel, smoothed by a 1-px Gaussian,
-// normalised to mean 1) is read at the pixels in front of a depth jump (up to 3 px), mapped
-// into a colour camera whose focal length is `ratio` times the depth's, about the same
-// principal point (u' = cx + ratio (u - cx)), for ratios 0.80 ... 1.20 in steps of 0.01. Over
-// enough frames with enough depth edges, a registered pair scores best at ratio 1 (TUM
-// fr3/teddy: 1.01, 1.04x the score at 1; every rendered sequence of docs/accuracy.md within
-// 0.01 of 1), an unregistered one away from it (7-Scenes' kitchen: 0.91, 1.6x; rendered at
-// 0.897: 0.88-0.90, 1.3-1.6x; at 1.1: 1.10, 1.27x), but not at the grid's ends (kGridEnd). The
-// verdict rests on that one-parameter search alone. Once unregistered, the frames' evidence is
-// searched again for the colour camera itself: its focal ratio within 0.03 of the one found and
-// its centre up to max_baseline along x (a Kinect's two cameras are 2.5 cm apart), each edge
-// pixel's point (its depth known) projected into it:
-// u' = cx + ratio (u - cx) - ratio fx baseline / z. With the depth, the baseline's shift differs from silhouette to silhouette by their depths,
-// which a texture does not mimic (rendered rooms at 0.897 and 2.5 cm: found within 1 cm and 0.01;
-// the ratio alone had come out 0.85-0.96, the baseline biasing it; docs/accuracy.md, fifteenth
-// round). Colour and depth of two instants (free-running streams) misalign by the motion between
-// them: Odometry, which runs the check, gives it the depth as it registered it (depthAsRegistered,
-// odometry.hpp), and resamples an unregistered camera's colour by the ratio found, or by the camera
-// found where asked (withColourResampled, below; OdometryParams::resample_colour_baseline).
+// normalised to mean 1) is read at the pixels in front of a depth jump (up to 3 px), each edge
+// pixel's point (its depth z known) projected into a colour camera whose focal length is
+// `ratio` times the depth's, about the same principal point, its centre `baseline` along x:
+// u' = cx + ratio (u - cx) - ratio fx baseline / z, v' = cy + ratio (v - cy). A grid of such
+// cameras (ratios 0.80 ... 1.20 by 0.01, centres within max_baseline by 1 cm; a Kinect's two
+// cameras are 2.5 cm apart) is scored on every counted frame. Over enough frames with enough
+// depth edges, a registered pair scores best at ratio 1 (TUM fr3/teddy: 1.01, 1.03x the score
+// at 1), an unregistered one away from it (7-Scenes' kitchen: 0.90 and 3 cm, 1.8x; rendered at
+// 0.897 and 2.5 cm: 0.89-0.91, 1.2-2.7x). The baseline's shift differs from silhouette to
+// silhouette by their depths, which a texture does not mimic; without it in the grid (as the
+// verdict once rested on the ratio alone) the camera's baseline blurs the ratio's peak, and a
+// colour camera on a fast, blurred camera went unseen (docs/accuracy.md, twenty-fourth round).
+// The verdict "unregistered" asks of the best camera of the grid: its ratio not at the grid's
+// ends (kGridEnd) and min_offset from 1; min_gain over a camera in the depth camera's place; the
+// same in all quarters of the image but one (min_quarter_gain: a person's colour late on its
+// silhouette fits a camera in one part of the image only); most frames' own best camera near
+// it (min_agreement); and the focal ratio alone that fits best near it (the default
+// resampling's, best_ratio) also min_offset from 1. Once unregistered, the frames' evidence is
+// searched finer about that camera (findColourCamera: rendered rooms at 0.897 and 2.5 cm, found
+// within 1 cm and 0.01; docs/accuracy.md, fifteenth round). Colour and depth of two instants
+// (free-running streams) misalign by the motion between them: Odometry, which runs the check,
+// gives it the depth as it registered it (depthAsRegistered, odometry.hpp), and resamples an
+// unregistered camera's colour by the ratio found, or by the camera found where asked
+// (withColourResampled, below; OdometryParams::resample_colour_baseline).
 #pragma once
 
 #include <array>
@@ -40,6 +46,10 @@ class ColourDepthCheck {
   static constexpr int kRatios = 41;  // 0.80, 0.81, ... 1.20
   static constexpr double kRatioStep = 0.01;
   static double ratioAt(int i) { return 0.8 + kRatioStep * i; }
+  static constexpr double kBaselineStep = 0.01;  // m: the camera grid's centres along x
+  // A quarter of the image with this share of the edge pixels or more has its say
+  // (min_quarter_gain).
+  static constexpr double kMinQuarterShare = 0.05;
   // A best ratio within this many steps of either end of the grid (0.80-0.83, 1.17-1.20) is not
   // taken for a camera: texture beside the silhouettes can make the score climb steadily across
   // the grid, with no peak (a rendered room at 0.897: its score rose from 0.58 at 0.89 to 1.18
@@ -50,35 +60,42 @@ class ColourDepthCheck {
   // Odometry gives it every kFrameStep-th frame until it decides. Every frame: the verdict
   // comes at the tenth frame with enough depth edges, so that colour from a second camera is
   // resampled (withColourResampled) from the first third of a second on. A frame looked at
-  // costs about 3 ms at 640x480, on those first frames only. Over 12 rendered registered
-  // sequences (texture, blur, delays, noise in blobs, fast turns) and teddy200 the verdict of
-  // ten neighbouring frames was "registered" with the best ratio within 0.03 of 1.
+  // costs about as much as registering one (the grid of 41 x 13 cameras on up to 1000 edge
+  // pixels), on those first frames only.
   static constexpr int kFrameStep = 1;
 
   struct Options {
     double depth_jump = 0.05;      // a depth edge: a pixel within 3 px is farther by this x z
     int min_edge_pixels = 500;     // a frame with fewer depth-edge pixels does not count
     int frames_needed = 10;        // counted frames before a verdict
-    double min_gain = 1.15;        // unregistered: the best ratio's score over ratio 1's ...
-    double min_offset = 0.04;      // ... the best ratio this far from 1 ...
-    double min_agreement = 0.6;    // ... and this fraction of the frames' own best within
-    double agreement_within = 0.03;  // this of the best ratio
+    double min_gain = 1.15;        // unregistered: the best camera's score over ratio 1's ...
+    double min_offset = 0.04;      // ... its ratio, and the ratio alone, this far from 1 ...
+    double min_quarter_gain = 1.1;  // ... and this gain in all quarters of the image but one ...
+    double min_agreement = 0.6;    // ... and this fraction of the frames' own best camera's
+    double agreement_within = 0.03;  // ratio within this of its ratio
     double max_baseline = 0.06;    // m: the colour camera's centre searched within this along x
-    int max_edges_per_frame = 1000;  // the camera search reads at most this many per frame
+    int max_edges_per_frame = 1000;  // the grid and the search read at most this many a frame
   };
 
   enum class State { kUndecided, kRegistered, kUnregistered };
 
   struct Verdict {
     State state = State::kUndecided;
-    double best_ratio = 1.0;  // the colour focal length over the depth's that fits best
+    // The colour focal length over the depth's that fits best alone (no baseline, every edge
+    // pixel): within agreement_within of grid_ratio once unregistered. The default resampling's.
+    double best_ratio = 1.0;
     // The colour camera found once unregistered (findColourCamera): its focal ratio and its
     // centre along x from the depth camera's, in m (best_ratio and 0 otherwise).
     double camera_ratio = 1.0;
     double baseline = 0.0;
-    double gain = 1.0;        // the score at best_ratio over the score at ratio 1
-    double agreement = 0.0;   // fraction of counted frames whose own best is within
-                              // agreement_within of best_ratio
+    // The camera of the search's grid (focal ratio by 0.01, centre by kBaselineStep) that fits
+    // best, and its score over the score of a camera in the depth camera's place.
+    double grid_ratio = 1.0;
+    double grid_baseline = 0.0;
+    double gain = 1.0;
+    double quarter_gain = 1.0;  // the same gain in the image's quarters: the second least
+    double agreement = 0.0;   // fraction of counted frames whose own best camera's ratio is
+                              // within agreement_within of grid_ratio
     int frames = 0;           // frames counted (enough depth edges)
     int frames_seen = 0;      // frames given
   };
@@ -115,6 +132,19 @@ class ColourDepthCheck {
   static std::array<double, kRatios> ratioScores(const cv::Mat& strength, const Camera& camera,
                                                  const std::vector<EdgePoint>& edges);
   void decide();
+  // The image's quarter of an edge pixel about the principal point (0-3), and the sums and counts
+  // of score() by quarter.
+  struct Quarters {
+    std::array<double, 4> sum{};
+    std::array<int, 4> n{};
+  };
+  static int quarterOf(const Camera& camera, const EdgePoint& e);
+  static Quarters quarterScores(const cv::Mat& strength, const Camera& camera,
+                                const std::vector<EdgePoint>& edges, double ratio,
+                                double baseline);
+  int baselines() const;           // the camera grid's centres: -max_baseline ... max_baseline
+  double baselineAt(int j) const;
+  std::size_t cameraIndex(int i, int j) const;  // ratio i, centre j in camera_sum_
   // Searches the kept evidence for the colour camera (Verdict::camera_ratio, baseline).
   void findColourCamera();
 
@@ -128,7 +158,10 @@ class ColourDepthCheck {
   std::vector<Evidence> evidence_;
   Camera camera_;
   std::array<double, kRatios> sum_{};
-  std::vector<int> frame_best_;  // per counted frame, the index of its best ratio
+  std::vector<double> camera_sum_;  // per camera of the grid (cameraIndex)
+  std::array<std::vector<double>, 4> quarter_sum_;  // the same, by the image's quarters
+  std::array<int, 4> quarter_edges_{};              // the evidence's edges in each quarter
+  std::vector<int> frame_camera_best_;  // per counted frame, its best camera's ratio index
   Verdict verdict_;
 };
 

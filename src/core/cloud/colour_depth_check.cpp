@@ -83,6 +83,27 @@ std::array<double, ColourDepthCheck::kRatios> ColourDepthCheck::ratioScores(
   return out;
 }
 
+int ColourDepthCheck::quarterOf(const Camera& camera, const EdgePoint& e) {
+  return (e.u > camera.cx ? 1 : 0) + (e.v > camera.cy ? 2 : 0);
+}
+
+ColourDepthCheck::Quarters ColourDepthCheck::quarterScores(const cv::Mat& strength,
+                                                           const Camera& camera,
+                                                           const std::vector<EdgePoint>& edges,
+                                                           double ratio, double baseline) {
+  const double shift = ratio * camera.fx * baseline;
+  Quarters q;
+  for (const EdgePoint& e : edges) {
+    const double x = camera.cx + ratio * (e.u - camera.cx) - shift / e.z;
+    const double y = camera.cy + ratio * (e.v - camera.cy);
+    if (!inside(strength, x, y)) continue;
+    const auto k = std::size_t(quarterOf(camera, e));
+    q.sum[k] += sample(strength, x, y);
+    ++q.n[k];
+  }
+  return q;
+}
+
 double ColourDepthCheck::score(const cv::Mat& strength, const Camera& camera,
                                const std::vector<EdgePoint>& edges, double ratio, double baseline) {
   const double shift = ratio * camera.fx * baseline;
@@ -113,12 +134,43 @@ const ColourDepthCheck::Verdict& ColourDepthCheck::add(const Frame& frame) {
   const auto s = ratioScores(evidence.strength, frame.camera, edges);
   if (s[kRatios / 2] <= 0.0) return verdict_;  // no colour edges (a blank colour image)
   for (int i = 0; i < kRatios; ++i) sum_[std::size_t(i)] += s[std::size_t(i)];
-  frame_best_.push_back(int(std::max_element(s.begin(), s.end()) - s.begin()));
   ++verdict_.frames;
   // The evidence for the camera search: the edge strength and the edges, evenly thinned.
   const std::size_t step = std::max<std::size_t>(
       1, edges.size() / std::size_t(std::max(1, options_.max_edges_per_frame)));
   for (std::size_t i = 0; i < edges.size(); i += step) evidence.edges.push_back(edges[i]);
+  // Every camera of the grid on this frame's thinned edges (41 x 13 cameras, up to 533k samples),
+  // in all and by the image's quarters about the principal point.
+  const int nb = baselines();
+  if (camera_sum_.empty()) {
+    camera_sum_.assign(cameraIndex(kRatios, 0), 0.0);
+    for (auto& q : quarter_sum_) q.assign(cameraIndex(kRatios, 0), 0.0);
+  }
+  for (const EdgePoint& e : evidence.edges) {
+    ++quarter_edges_[std::size_t(quarterOf(frame.camera, e))];
+  }
+  int frame_best = 0;
+  double frame_best_score = -1.0;
+  for (int i = 0; i < kRatios; ++i) {
+    for (int j = 0; j < nb; ++j) {
+      const Quarters q =
+          quarterScores(evidence.strength, frame.camera, evidence.edges, ratioAt(i), baselineAt(j));
+      double sum = 0.0;
+      int n = 0;
+      for (std::size_t k = 0; k < 4; ++k) {
+        sum += q.sum[k];
+        n += q.n[k];
+        if (q.n[k] > 0) quarter_sum_[k][cameraIndex(i, j)] += q.sum[k] / q.n[k];
+      }
+      const double c = n > 0 ? sum / n : 0.0;
+      camera_sum_[cameraIndex(i, j)] += c;
+      if (c > frame_best_score) {
+        frame_best_score = c;
+        frame_best = i;
+      }
+    }
+  }
+  frame_camera_best_.push_back(frame_best);
   evidence_.push_back(std::move(evidence));
   camera_ = frame.camera;
   if (verdict_.frames >= options_.frames_needed) {
@@ -132,22 +184,64 @@ const ColourDepthCheck::Verdict& ColourDepthCheck::add(const Frame& frame) {
 
 bool ColourDepthCheck::atGridEnd(int i) { return i < kGridEnd || i >= kRatios - kGridEnd; }
 
+int ColourDepthCheck::baselines() const {
+  return 2 * int(std::lround(options_.max_baseline / kBaselineStep)) + 1;
+}
+
+double ColourDepthCheck::baselineAt(int j) const {
+  const int centre = baselines() / 2;
+  return double(j - centre) * kBaselineStep;
+}
+
+std::size_t ColourDepthCheck::cameraIndex(int i, int j) const {
+  return std::size_t(i) * std::size_t(baselines()) + std::size_t(j);
+}
+
 void ColourDepthCheck::decide() {
-  const int best = int(std::max_element(sum_.begin(), sum_.end()) - sum_.begin());
   const int one = kRatios / 2;  // ratio 1.00
-  verdict_.best_ratio = verdict_.camera_ratio = ratioAt(best);
-  verdict_.gain = sum_[std::size_t(best)] / sum_[std::size_t(one)];
   // Options in ratios, as whole steps of the ratio grid.
   auto steps = [](double ratio) { return int(std::lround(ratio / kRatioStep)); };
-  const int within = steps(options_.agreement_within);
-  const int near = int(std::count_if(frame_best_.begin(), frame_best_.end(),
+  const int within = steps(options_.agreement_within), offset = steps(options_.min_offset);
+  // The colour camera of the grid that fits best, against a camera in the depth camera's place.
+  const int nb = baselines();
+  const std::size_t at_one = cameraIndex(one, nb / 2);
+  const auto best_camera = std::size_t(
+      std::max_element(camera_sum_.begin(), camera_sum_.end()) - camera_sum_.begin());
+  const int best = int(best_camera) / nb;
+  verdict_.grid_ratio = ratioAt(best);
+  verdict_.grid_baseline = baselineAt(int(best_camera) % nb);
+  verdict_.gain = camera_sum_[best_camera] / camera_sum_[at_one];
+  const int near = int(std::count_if(frame_camera_best_.begin(), frame_camera_best_.end(),
                                      [&](int b) { return std::abs(b - best) <= within; }));
-  verdict_.agreement = double(near) / double(frame_best_.size());
-  const bool unregistered = !atGridEnd(best) &&
-                            std::abs(best - one) >= steps(options_.min_offset) &&
-                            verdict_.gain >= options_.min_gain &&
-                            verdict_.agreement >= options_.min_agreement;
+  verdict_.agreement = double(near) / double(frame_camera_best_.size());
+  // Each quarter of the image with its share of the edges on its own: a camera of another focal
+  // length moves the colour off the silhouettes everywhere, outwards or inwards, and the camera
+  // found must fit all quarters but one better than the depth camera's place does (one may hold
+  // silhouettes of little contrast, or ones the colour camera sees past).
+  const int all_edges =
+      quarter_edges_[0] + quarter_edges_[1] + quarter_edges_[2] + quarter_edges_[3];
+  std::vector<double> gains;
+  for (std::size_t k = 0; k < 4; ++k) {
+    if (quarter_edges_[k] < kMinQuarterShare * all_edges) continue;
+    const double there = quarter_sum_[k][at_one];
+    gains.push_back(there > 0.0 ? quarter_sum_[k][best_camera] / there : 0.0);
+  }
+  std::sort(gains.begin(), gains.end());
+  verdict_.quarter_gain = gains.size() >= 3 ? gains[1] : (gains.empty() ? 0.0 : gains[0]);
+  // The focal ratio alone (every edge pixel, no baseline) that fits best near the camera's: what
+  // the default resampling uses, so it too must be away from 1.
+  const auto near_first = sum_.begin() + std::max(0, best - within);
+  const auto near_last = sum_.begin() + std::min(kRatios, best + within + 1);
+  const int alone = int(std::max_element(near_first, near_last) - sum_.begin());
+  const bool unregistered = !atGridEnd(best) && std::abs(best - one) >= offset &&
+                            std::abs(alone - one) >= offset && verdict_.gain >= options_.min_gain &&
+                            verdict_.agreement >= options_.min_agreement &&
+                            verdict_.quarter_gain >= options_.min_quarter_gain;
   verdict_.state = unregistered ? State::kUnregistered : State::kRegistered;
+  verdict_.best_ratio = verdict_.camera_ratio =
+      unregistered ? ratioAt(alone)
+                   : ratioAt(int(std::max_element(sum_.begin(), sum_.end()) - sum_.begin()));
+  if (unregistered) verdict_.camera_ratio = verdict_.grid_ratio;  // findColourCamera refines it
 }
 
 void ColourDepthCheck::findColourCamera() {
@@ -177,7 +271,7 @@ void ColourDepthCheck::findColourCamera() {
       }
     }
   };
-  search(verdict_.best_ratio, 0.03, 0.005, 0.0, options_.max_baseline, 0.005);
+  search(verdict_.camera_ratio, 0.03, 0.005, 0.0, options_.max_baseline, 0.005);
   search(verdict_.camera_ratio, 0.004, 0.001, verdict_.baseline, 0.004, 0.001);
 }
 
@@ -191,19 +285,20 @@ std::string ColourDepthCheck::describe() const {
                     v.frames, v.frames_seen);
       break;
     case State::kRegistered:
-      if (atGridEnd(int(std::lround((v.best_ratio - ratioAt(0)) / kRatioStep)))) {
+      if (atGridEnd(int(std::lround((v.grid_ratio - ratioAt(0)) / kRatioStep)))) {
         std::snprintf(text, sizeof text,
                       "colour/depth registration: taken as registered, no focal ratio stands out "
                       "(the colour edges' score still climbs at the search's end, ratio %.2f, "
                       "%.2fx ratio 1's score, %d frames). If the depth comes from a second "
                       "camera, register it to the colour (depth_image_proc/register)",
-                      v.best_ratio, v.gain, v.frames);
+                      v.grid_ratio, v.gain, v.frames);
         break;
       }
       std::snprintf(text, sizeof text,
-                    "colour/depth registration: the colour edges lie on the depth edges (best "
-                    "focal ratio %.2f, %.2fx ratio 1's score, %d frames)",
-                    v.best_ratio, v.gain, v.frames);
+                    "colour/depth registration: the colour edges lie on the depth edges (no "
+                    "other colour camera stands out: the best, focal ratio %.2f with its centre "
+                    "%.1f cm along x, scores %.2fx the images as given; %d frames)",
+                    v.grid_ratio, 100.0 * v.grid_baseline, v.gain, v.frames);
       break;
     case State::kUnregistered:
       std::snprintf(text, sizeof text,
