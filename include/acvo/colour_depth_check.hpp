@@ -14,8 +14,8 @@
 // cameras (ratios 0.80 ... 1.20 by 0.01, centres within max_baseline by 1 cm; a Kinect's two
 // cameras are 2.5 cm apart) is scored on every counted frame. Over enough frames with enough
 // depth edges, a registered pair scores best at ratio 1 (TUM fr3/teddy: 1.01, 1.03x the score
-// at 1), an unregistered one away from it (7-Scenes' kitchen: 0.90 and 3 cm, 1.8x; rendered at
-// 0.897 and 2.5 cm: 0.89-0.91, 1.2-2.7x). The baseline's shift differs from silhouette to
+// at 1), an unregistered one away from it (7-Scenes' kitchen: 0.90 and 3 cm, 1.8x; rendered
+// cameras of 0.9 and 2.5 cm: 0.86-0.94, 1.2-2.7x). The baseline's shift differs from silhouette to
 // silhouette by their depths, which a texture does not mimic; without it in the grid (as the
 // verdict once rested on the ratio alone) the camera's baseline blurs the ratio's peak, and a
 // colour camera on a fast, blurred camera went unseen (docs/accuracy.md, twenty-fourth round).
