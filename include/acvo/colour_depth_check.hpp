@@ -24,7 +24,7 @@
 // same in all quarters of the image but one (min_quarter_gain: a person's colour late on its
 // silhouette fits a camera in one part of the image only); most frames' own best camera near
 // it (min_agreement); and the focal ratio alone that fits best near it (the default
-// resampling's, best_ratio) also min_offset from 1. Once unregistered, the frames' evidence is
+// resampling's, best_ratio) also min_offset from 1 and not at the grid's ends. Once unregistered, the frames' evidence is
 // searched finer about that camera (findColourCamera: rendered rooms at 0.897 and 2.5 cm, found
 // within 1 cm and 0.01; docs/accuracy.md, fifteenth round). Colour and depth of two instants
 // (free-running streams) misalign by the motion between them: Odometry, which runs the check,
@@ -60,8 +60,8 @@ class ColourDepthCheck {
   // Odometry gives it every kFrameStep-th frame until it decides. Every frame: the verdict
   // comes at the tenth frame with enough depth edges, so that colour from a second camera is
   // resampled (withColourResampled) from the first third of a second on. A frame looked at
-  // costs about as much as registering one (the grid of 41 x 13 cameras on up to 1000 edge
-  // pixels), on those first frames only.
+  // costs about as much as registering one (the grid of 41 x 13 cameras on its thinned edge
+  // pixels, up to 2000 of them), on those first frames only.
   static constexpr int kFrameStep = 1;
 
   struct Options {
@@ -74,7 +74,8 @@ class ColourDepthCheck {
     double min_agreement = 0.6;    // ... and this fraction of the frames' own best camera's
     double agreement_within = 0.03;  // ratio within this of its ratio
     double max_baseline = 0.06;    // m: the colour camera's centre searched within this along x
-    int max_edges_per_frame = 1000;  // the grid and the search read at most this many a frame
+    int max_edges_per_frame = 1000;  // the grid and the search read every k-th edge pixel of a
+                                     // frame, k = edges / this (rounded down)
   };
 
   enum class State { kUndecided, kRegistered, kUnregistered };
@@ -82,7 +83,7 @@ class ColourDepthCheck {
   struct Verdict {
     State state = State::kUndecided;
     // The colour focal length over the depth's that fits best alone (no baseline, every edge
-    // pixel): within agreement_within of grid_ratio once unregistered. The default resampling's.
+    // pixel) within agreement_within of grid_ratio: the default resampling's.
     double best_ratio = 1.0;
     // The colour camera found once unregistered (findColourCamera): its focal ratio and its
     // centre along x from the depth camera's, in m (best_ratio and 0 otherwise).
@@ -93,7 +94,9 @@ class ColourDepthCheck {
     double grid_ratio = 1.0;
     double grid_baseline = 0.0;
     double gain = 1.0;
-    double quarter_gain = 1.0;  // the same gain in the image's quarters: the second least
+    // The same gain in the image's quarters that hold kMinQuarterShare of the edges: the second
+    // least of three or four, else the least.
+    double quarter_gain = 1.0;
     double agreement = 0.0;   // fraction of counted frames whose own best camera's ratio is
                               // within agreement_within of grid_ratio
     int frames = 0;           // frames counted (enough depth edges)

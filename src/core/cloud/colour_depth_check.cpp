@@ -29,7 +29,10 @@ float sample(const cv::Mat& image, double x, double y) {
 
 }  // namespace
 
-ColourDepthCheck::ColourDepthCheck(const Options& options) : options_(options) {}
+ColourDepthCheck::ColourDepthCheck(const Options& options) : options_(options) {
+  camera_sum_.assign(cameraIndex(kRatios, 0), 0.0);
+  for (auto& q : quarter_sum_) q.assign(camera_sum_.size(), 0.0);
+}
 
 std::vector<std::array<int, 2>> ColourDepthCheck::depthEdges(const cv::Mat& depth,
                                                              double depth_jump) {
@@ -133,22 +136,18 @@ const ColourDepthCheck::Verdict& ColourDepthCheck::add(const Frame& frame) {
   evidence.strength = edgeStrength(grayImage(frame));
   const auto s = ratioScores(evidence.strength, frame.camera, edges);
   if (s[kRatios / 2] <= 0.0) return verdict_;  // no colour edges (a blank colour image)
-  for (int i = 0; i < kRatios; ++i) sum_[std::size_t(i)] += s[std::size_t(i)];
-  ++verdict_.frames;
-  // The evidence for the camera search: the edge strength and the edges, evenly thinned.
+  // The evidence for the grid and the camera search: the edge strength and the edges, thinned to
+  // every k-th (k = edges / max_edges_per_frame, rounded down: under twice that many, all).
   const std::size_t step = std::max<std::size_t>(
       1, edges.size() / std::size_t(std::max(1, options_.max_edges_per_frame)));
   for (std::size_t i = 0; i < edges.size(); i += step) evidence.edges.push_back(edges[i]);
-  // Every camera of the grid on this frame's thinned edges (41 x 13 cameras, up to 533k samples),
-  // in all and by the image's quarters about the principal point.
+  // Every camera of the grid on those edges (41 x 13 cameras), in all and by the image's quarters
+  // about the principal point. A quarter whose edges a camera does not see at all adds nothing
+  // for it, which errs towards "registered".
   const int nb = baselines();
-  if (camera_sum_.empty()) {
-    camera_sum_.assign(cameraIndex(kRatios, 0), 0.0);
-    for (auto& q : quarter_sum_) q.assign(cameraIndex(kRatios, 0), 0.0);
-  }
-  for (const EdgePoint& e : evidence.edges) {
-    ++quarter_edges_[std::size_t(quarterOf(frame.camera, e))];
-  }
+  std::vector<double> cameras(camera_sum_.size(), 0.0);
+  std::array<std::vector<double>, 4> quarters;
+  for (auto& q : quarters) q.assign(camera_sum_.size(), 0.0);
   int frame_best = 0;
   double frame_best_score = -1.0;
   for (int i = 0; i < kRatios; ++i) {
@@ -160,15 +159,26 @@ const ColourDepthCheck::Verdict& ColourDepthCheck::add(const Frame& frame) {
       for (std::size_t k = 0; k < 4; ++k) {
         sum += q.sum[k];
         n += q.n[k];
-        if (q.n[k] > 0) quarter_sum_[k][cameraIndex(i, j)] += q.sum[k] / q.n[k];
+        if (q.n[k] > 0) quarters[k][cameraIndex(i, j)] = q.sum[k] / q.n[k];
       }
       const double c = n > 0 ? sum / n : 0.0;
-      camera_sum_[cameraIndex(i, j)] += c;
+      cameras[cameraIndex(i, j)] = c;
       if (c > frame_best_score) {
         frame_best_score = c;
         frame_best = i;
       }
     }
+  }
+  // The thinned edges may all lie where the colour is flat: such a frame says nothing.
+  if (!(cameras[cameraIndex(kRatios / 2, nb / 2)] > 0.0)) return verdict_;
+  for (int i = 0; i < kRatios; ++i) sum_[std::size_t(i)] += s[std::size_t(i)];
+  ++verdict_.frames;
+  for (std::size_t c = 0; c < cameras.size(); ++c) {
+    camera_sum_[c] += cameras[c];
+    for (std::size_t k = 0; k < 4; ++k) quarter_sum_[k][c] += quarters[k][c];
+  }
+  for (const EdgePoint& e : evidence.edges) {
+    ++quarter_edges_[std::size_t(quarterOf(frame.camera, e))];
   }
   frame_camera_best_.push_back(frame_best);
   evidence_.push_back(std::move(evidence));
@@ -185,7 +195,9 @@ const ColourDepthCheck::Verdict& ColourDepthCheck::add(const Frame& frame) {
 bool ColourDepthCheck::atGridEnd(int i) { return i < kGridEnd || i >= kRatios - kGridEnd; }
 
 int ColourDepthCheck::baselines() const {
-  return 2 * int(std::lround(options_.max_baseline / kBaselineStep)) + 1;
+  // Centres by kBaselineStep within max_baseline (none beyond it; just 0 for a negative or NaN).
+  const double steps = std::floor(options_.max_baseline / kBaselineStep + 1e-9);
+  return 2 * (steps > 0.0 ? int(std::min(steps, 100.0)) : 0) + 1;
 }
 
 double ColourDepthCheck::baselineAt(int j) const {
@@ -210,7 +222,7 @@ void ColourDepthCheck::decide() {
   const int best = int(best_camera) / nb;
   verdict_.grid_ratio = ratioAt(best);
   verdict_.grid_baseline = baselineAt(int(best_camera) % nb);
-  verdict_.gain = camera_sum_[best_camera] / camera_sum_[at_one];
+  verdict_.gain = camera_sum_[at_one] > 0.0 ? camera_sum_[best_camera] / camera_sum_[at_one] : 1.0;
   const int near = int(std::count_if(frame_camera_best_.begin(), frame_camera_best_.end(),
                                      [&](int b) { return std::abs(b - best) <= within; }));
   verdict_.agreement = double(near) / double(frame_camera_best_.size());
@@ -229,18 +241,17 @@ void ColourDepthCheck::decide() {
   std::sort(gains.begin(), gains.end());
   verdict_.quarter_gain = gains.size() >= 3 ? gains[1] : (gains.empty() ? 0.0 : gains[0]);
   // The focal ratio alone (every edge pixel, no baseline) that fits best near the camera's: what
-  // the default resampling uses, so it too must be away from 1.
+  // the default resampling uses, so it too must be away from 1 (and from the grid's ends).
   const auto near_first = sum_.begin() + std::max(0, best - within);
   const auto near_last = sum_.begin() + std::min(kRatios, best + within + 1);
   const int alone = int(std::max_element(near_first, near_last) - sum_.begin());
-  const bool unregistered = !atGridEnd(best) && std::abs(best - one) >= offset &&
-                            std::abs(alone - one) >= offset && verdict_.gain >= options_.min_gain &&
+  const bool unregistered = !atGridEnd(best) && !atGridEnd(alone) &&
+                            std::abs(best - one) >= offset && std::abs(alone - one) >= offset &&
+                            verdict_.gain >= options_.min_gain &&
                             verdict_.agreement >= options_.min_agreement &&
                             verdict_.quarter_gain >= options_.min_quarter_gain;
   verdict_.state = unregistered ? State::kUnregistered : State::kRegistered;
-  verdict_.best_ratio = verdict_.camera_ratio =
-      unregistered ? ratioAt(alone)
-                   : ratioAt(int(std::max_element(sum_.begin(), sum_.end()) - sum_.begin()));
+  verdict_.best_ratio = verdict_.camera_ratio = ratioAt(alone);
   if (unregistered) verdict_.camera_ratio = verdict_.grid_ratio;  // findColourCamera refines it
 }
 
@@ -304,12 +315,12 @@ std::string ColourDepthCheck::describe() const {
       std::snprintf(text, sizeof text,
                     "the depth image does not look registered to the colour image: the colour "
                     "edges fit the depth edges best with the colour focal length %.2f times the "
-                    "depth's (%.1fx the score as given, %d frames; as a camera beside the depth "
-                    "camera: %.3f times, its centre %.1f cm along x). acvo needs depth registered "
-                    "pixel for pixel to the colour camera: use the driver's depth_registered "
-                    "image (openni2_launch depth_registration:=true, realsense2_camera "
-                    "align_depth:=true) or depth_image_proc/register",
-                    v.best_ratio, v.gain, v.frames, v.camera_ratio, 100.0 * v.baseline);
+                    "depth's (%d frames; as a camera beside the depth camera: %.3f times, its "
+                    "centre %.1f cm along x, at least %.1fx the score as given). acvo needs depth "
+                    "registered pixel for pixel to the colour camera: use the driver's "
+                    "depth_registered image (openni2_launch depth_registration:=true, "
+                    "realsense2_camera align_depth:=true) or depth_image_proc/register",
+                    v.best_ratio, v.frames, v.camera_ratio, 100.0 * v.baseline, v.gain);
       break;
   }
   return text;
