@@ -109,17 +109,9 @@ ColourDepthCheck::Quarters ColourDepthCheck::quarterScores(const cv::Mat& streng
 
 double ColourDepthCheck::score(const cv::Mat& strength, const Camera& camera,
                                const std::vector<EdgePoint>& edges, double ratio, double baseline) {
-  const double shift = ratio * camera.fx * baseline;
-  double sum = 0.0;
-  int n = 0;
-  for (const EdgePoint& e : edges) {
-    const double x = camera.cx + ratio * (e.u - camera.cx) - shift / e.z;
-    const double y = camera.cy + ratio * (e.v - camera.cy);
-    if (!inside(strength, x, y)) continue;
-    sum += sample(strength, x, y);
-    ++n;
-  }
-  return n > 0 ? sum / double(n) : 0.0;
+  const Quarters q = quarterScores(strength, camera, edges, ratio, baseline);
+  const int n = q.n[0] + q.n[1] + q.n[2] + q.n[3];
+  return n > 0 ? (q.sum[0] + q.sum[1] + q.sum[2] + q.sum[3]) / double(n) : 0.0;
 }
 
 const ColourDepthCheck::Verdict& ColourDepthCheck::add(const Frame& frame) {
