@@ -23,9 +23,10 @@ using State = ColourDepthCheck::State;
 
 // Every kFrameStep-th frame of a rendered sequence (as Odometry looks), until
 // decided.
-ColourDepthCheck::Verdict judge(synth::SequenceOptions o) {
+ColourDepthCheck::Verdict judge(synth::SequenceOptions o,
+                                const ColourDepthCheck::Options& options = {}) {
   const synth::SynthSequence sequence(o);
-  ColourDepthCheck check;
+  ColourDepthCheck check(options);
   for (int i = 0; i < sequence.size() && !check.decided(); i += ColourDepthCheck::kFrameStep) {
     check.add(sequence.frame(i).toFrame());
   }
@@ -129,15 +130,10 @@ TEST(ColourDepthCheck, AScoreClimbingToTheGridsEndIsNoCamera) {
 // Without centres to search (max_baseline 0, or a negative one read as 0) the grid is the focal
 // ratio alone, and a colour camera with no baseline is still found by it.
 TEST(ColourDepthCheck, AGridWithoutCentresIsTheRatioAlone) {
-  const synth::SynthSequence sequence(exactRoom(0.897));
   for (const double max_baseline : {0.0, -1.0}) {
     ColourDepthCheck::Options options;
     options.max_baseline = max_baseline;
-    ColourDepthCheck check(options);
-    for (int i = 0; i < sequence.size() && !check.decided(); ++i) {
-      check.add(sequence.frame(i).toFrame());
-    }
-    const auto& v = check.verdict();
+    const auto v = judge(exactRoom(0.897), options);
     EXPECT_EQ(v.state, State::kUnregistered) << max_baseline;
     EXPECT_NEAR(v.grid_ratio, 0.9, 0.015) << max_baseline;
     EXPECT_EQ(v.grid_baseline, 0.0) << max_baseline;
