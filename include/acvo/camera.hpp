@@ -26,7 +26,12 @@ struct Camera {
   Eigen::Vector2d project(const Eigen::Vector3d& p) const {
     return {fx * p.x() / p.z() + cx, fy * p.y() / p.z() + cy};
   }
-  bool valid() const;  // positive focal lengths, positive size and depth scale, all finite
+  // Non-zero focal lengths, positive size and depth scale, all finite. A negative focal length is
+  // an image axis that runs against the optical frame's, mirrored (ICL-NUIM's published
+  // intrinsics have fy -480: its renderer's y axis points up). Back-projection and projection
+  // hold with the sign as given, and the motion is the camera's in the frame they define.
+  bool valid() const;
+  bool mirrored() const { return fx < 0 || fy < 0; }
 };
 
 // Named intrinsics of the TUM RGB-D benchmark: "fr1", "fr2", "fr3", "default"

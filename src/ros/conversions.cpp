@@ -129,7 +129,8 @@ DepthImage decodeDepth(const sensor_msgs::Image& msg) {
 std::string IntrinsicsOverride::problem() const {
   const bool any = fx != 0.0 || fy != 0.0 || cx != 0.0 || cy != 0.0;
   if (any && !explicitValues()) {
-    return "fx, fy, cx, cy must all be set and positive to override the intrinsics (got " +
+    return "fx, fy, cx, cy must all be set to override the intrinsics (fx, fy not zero, cx, cy "
+           "positive; got " +
            std::to_string(fx) + ", " + std::to_string(fy) + ", " + std::to_string(cx) + ", " +
            std::to_string(cy) + ")";
   }
@@ -197,10 +198,11 @@ CameraResult cameraFor(const sensor_msgs::CameraInfo& info, int width, int heigh
     cam.fy = k(1, 1);
     cam.cx = k(0, 2);
     cam.cy = k(1, 2);
-    if (!(cam.fx > 0.0 && cam.fy > 0.0 && std::isfinite(cam.fx) && std::isfinite(cam.fy) &&
+    // (A negative focal length is a mirrored image axis, as acvo::Camera takes it.)
+    if (!(cam.fx != 0.0 && cam.fy != 0.0 && std::isfinite(cam.fx) && std::isfinite(cam.fy) &&
           std::isfinite(cam.cx) && std::isfinite(cam.cy))) {
       out.problem = std::string("camera_info ") + (has_p ? "P" : "K") +
-                    " has a zero, negative or non-finite focal length or centre (fx " +
+                    " has a zero or non-finite focal length or centre (fx " +
                     std::to_string(cam.fx) + ", fy " + std::to_string(cam.fy) + ")";
       return out;
     }
@@ -216,6 +218,10 @@ std::string describeCamera(const acvo::Camera& camera, const IntrinsicsOverride&
   std::ostringstream text;
   text << "fx " << camera.fx << ", fy " << camera.fy << ", cx " << camera.cx << ", cy "
        << camera.cy << " (" << camera.width << "x" << camera.height << ") ";
+  if (camera.mirrored()) {
+    text << "(a negative focal length: that image axis runs against the optical frame's, "
+            "mirrored) ";
+  }
   if (source.explicitValues()) {
     text << "from the parameters fx, fy, cx, cy";
   } else if (source.named()) {

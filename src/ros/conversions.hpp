@@ -45,12 +45,13 @@ struct DepthImage {
 DepthImage decodeDepth(const sensor_msgs::Image& msg);
 
 // Where intrinsics come from when not from CameraInfo: a TUM name ("fr1", "fr2", "fr3",
-// "default"; "" or "info" = use CameraInfo) or explicit fx, fy, cx, cy (all four > 0).
+// "default"; "" or "info" = use CameraInfo) or explicit fx, fy, cx, cy (fx, fy non-zero: a negative
+// one is a mirrored axis; cx, cy > 0).
 struct IntrinsicsOverride {
   std::string camera;
   double fx = 0.0, fy = 0.0, cx = 0.0, cy = 0.0;
 
-  bool explicitValues() const { return fx > 0.0 && fy > 0.0 && cx > 0.0 && cy > 0.0; }
+  bool explicitValues() const { return fx != 0.0 && fy != 0.0 && cx > 0.0 && cy > 0.0; }
   bool named() const { return !camera.empty() && camera != "info"; }
   bool fromCameraInfo() const { return !explicitValues() && !named(); }
   // Empty when consistent; otherwise says what is wrong (unknown name, partial fx..cy).

@@ -102,6 +102,12 @@ int main(int argc, char** argv) {
                 << "carries that in full (--camera FILE gives a calibration; fr1, fr2 or fr3, "
                 << "TUM's)\n";
     }
+    if (data.camera().mirrored()) {
+      std::cerr << "acvo_tum: note: a negative focal length (fx " << data.camera().fx << ", fy "
+                << data.camera().fy << "): that image axis runs against the optical frame's, as in "
+                << "ICL-NUIM's intrinsics (fy -480); pixels are back-projected with the signs "
+                << "given, and the trajectory is in the optical frame they define\n";
+    }
     const std::string output =
         opt.output.empty() ? opt.dataset + "/acvo_trajectory.txt" : opt.output;
     const long first = std::min<long>(opt.start, long(data.size()));

@@ -164,6 +164,13 @@ TEST(CameraFor, UsesCameraInfoAndChecksIt) {
             std::string::npos);
   EXPECT_NE(cameraFor(info(500, 510, 320, 240, 320, 240), 640, 480, {}).problem.find("320x240"),
             std::string::npos);
+  // A mirrored y axis (ICL-NUIM's intrinsics, fy -480) is a camera, and said to be one.
+  const CameraResult mirrored = cameraFor(info(481.2, -480, 319.5, 239.5, 640, 480), 640, 480, {});
+  ASSERT_EQ(mirrored.problem, "");
+  expectIntrinsics(mirrored.camera, 481.2, -480, 319.5, 239.5);
+  EXPECT_TRUE(mirrored.camera.valid());
+  EXPECT_NE(describeCamera(mirrored.camera, {}, {}).find("mirrored"), std::string::npos);
+  EXPECT_EQ(describeCamera(ok.camera, {}, {}).find("mirrored"), std::string::npos);
 }
 
 // A rectified stream of a distorted camera: K describes the raw image, P the rectified one the
@@ -220,6 +227,9 @@ TEST(CameraFor, OverridesWinOverCameraInfo) {
   const CameraResult v = cameraFor(zero, 640, 480, values);
   ASSERT_EQ(v.problem, "");
   EXPECT_DOUBLE_EQ(v.camera.fy, 401);
+  values.fy = -401;  // a mirrored y axis
+  EXPECT_EQ(values.problem(), "");
+  EXPECT_DOUBLE_EQ(cameraFor(zero, 640, 480, values).camera.fy, -401);
 
   IntrinsicsOverride partial;
   partial.fx = 400;

@@ -160,19 +160,29 @@ TEST(Camera, YamlProblemsNameTheFileAndTheKey) {
   why = errorOf([&] { acvo::loadCameraYaml(not_number); });
   EXPECT_NE(why.find("fx"), std::string::npos) << why;
 
-  const std::string negative = (dir / "negative.yaml").string();
-  writeText(negative, "fx: -500\nfy: 501\ncx: 300\ncy: 200\nwidth: 600\nheight: 400\n");
-  why = errorOf([&] { acvo::loadCameraYaml(negative); });
-  EXPECT_NE(why.find(negative), std::string::npos) << why;
+  const std::string zero = (dir / "zero.yaml").string();
+  writeText(zero, "fx: 0\nfy: 501\ncx: 300\ncy: 200\nwidth: 600\nheight: 400\n");
+  why = errorOf([&] { acvo::loadCameraYaml(zero); });
+  EXPECT_NE(why.find(zero), std::string::npos) << why;
+  EXPECT_NE(why.find("zero focal length"), std::string::npos) << why;
+
+  const std::string mirrored = (dir / "mirrored.yaml").string();
+  writeText(mirrored, "fx: 481.2\nfy: -480\ncx: 319.5\ncy: 239.5\nwidth: 640\nheight: 480\n");
+  EXPECT_DOUBLE_EQ(acvo::loadCameraYaml(mirrored).fy, -480.0);
 
   const std::string absent = (dir / "absent.yaml").string();
   why = errorOf([&] { acvo::loadCameraYaml(absent); });
   EXPECT_NE(why.find(absent), std::string::npos) << why;
 }
 
-TEST(Camera, ValidRejectsNonPositiveAndNonFinite) {
+TEST(Camera, ValidRejectsZeroNonPositiveSizesAndNonFinite) {
   Camera c;
   EXPECT_TRUE(c.valid());
+  EXPECT_FALSE(c.mirrored());
+  c.fy = -480.0;  // a mirrored y axis (ICL-NUIM's intrinsics)
+  EXPECT_TRUE(c.valid());
+  EXPECT_TRUE(c.mirrored());
+  c = Camera();
   c.fx = std::numeric_limits<double>::quiet_NaN();
   EXPECT_FALSE(c.valid());
   c = Camera();

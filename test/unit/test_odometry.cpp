@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 #include <Eigen/Eigenvalues>
+#include <opencv2/core.hpp>
 
 #include "acvo/depth.hpp"
 #include "acvo/odometry.hpp"
@@ -87,6 +88,56 @@ TEST(Odometry, FirstFrameThenTracksAnExactSequence) {
     EXPECT_LT(C.diagonal().maxCoeff(), 1e-2);
     EXPECT_GT(r.ms_cloud, 0.0);
     EXPECT_GT(r.solver.nnz, 0u);
+  }
+}
+
+// The frame mirrored about its horizontal (flip_code 0) or vertical (1) axis, with the camera that
+// says so: that axis's focal length negated, its centre mirrored. Each pixel back-projects to the
+// point it did before.
+Frame mirroredFrame(const Frame& f, int flip_code) {
+  Frame out = f;
+  cv::flip(f.color, out.color, flip_code);
+  cv::flip(f.depth, out.depth, flip_code);
+  if (flip_code == 0) {
+    out.camera.fy = -f.camera.fy;
+    out.camera.cy = (f.camera.height - 1) - f.camera.cy;
+  } else {
+    out.camera.fx = -f.camera.fx;
+    out.camera.cx = (f.camera.width - 1) - f.camera.cx;
+  }
+  return out;
+}
+
+// A camera whose image axis is mirrored, as in ICL-NUIM's published intrinsics (fy -480, its
+// renderer's y axis pointing up), is tracked as the same frames unmirrored are: to a tenth of a
+// millimetre on this rendered room (the largest errors over the 7 frames: 0.18 mm and 0.004 deg
+// as rendered, 0.19 mm and 0.005 deg upside down, 0.14 mm and 0.003 deg mirrored left to right).
+TEST(Odometry, AMirroredImageAxisIsANegativeFocalLength) {
+  synth::SequenceOptions o;
+  o.frames = 8;
+  o.speed = 0.5;
+  const synth::SynthSequence seq(o);
+  for (int flip_code : {-2, 0, 1}) {  // -2: as rendered
+    Odometry odo;
+    odo.reset(seq.poses()[0]);
+    double worst_mm = 0.0, worst_deg = 0.0;
+    for (int i = 0; i < seq.size(); ++i) {
+      const Frame frame = seq.frame(i).toFrame();
+      const OdometryResult r = odo.process(flip_code < -1 ? frame : mirroredFrame(frame, flip_code));
+      if (i == 0) {
+        EXPECT_EQ(r.tracking, Tracking::kFirstFrame) << r.message;
+        continue;
+      }
+      EXPECT_TRUE(r.tracking == Tracking::kOk || r.tracking == Tracking::kHard)
+          << "flip " << flip_code << ", frame " << i << ": " << r.message;
+      const Eigen::Isometry3d true_motion = seq.poses()[i - 1].inverse() * seq.poses()[i];
+      worst_mm = std::max(worst_mm, 1e3 * translationError(true_motion, r.motion));
+      worst_deg = std::max(worst_deg, rotationErrorDeg(true_motion, r.motion));
+    }
+    std::printf("flip %d: at most %.2f mm and %.4f deg off the truth\n", flip_code, worst_mm,
+                worst_deg);
+    EXPECT_LT(worst_mm, 0.3) << "flip " << flip_code;
+    EXPECT_LT(worst_deg, 0.008) << "flip " << flip_code;
   }
 }
 

@@ -15,7 +15,7 @@ namespace acvo {
 bool Camera::valid() const {
   const bool finite = std::isfinite(fx) && std::isfinite(fy) && std::isfinite(cx) &&
                       std::isfinite(cy) && std::isfinite(depth_scale);
-  return finite && fx > 0 && fy > 0 && width > 0 && height > 0 && depth_scale > 0;
+  return finite && fx != 0 && fy != 0 && width > 0 && height > 0 && depth_scale > 0;
 }
 
 Camera cameraByName(const std::string& name) {
@@ -127,7 +127,7 @@ Camera intrinsicsOf(const CameraYaml& yaml) {
   yaml.get("depth_scale", c.depth_scale, false);
   Camera sized = c;
   if (sized.width == 0 && sized.height == 0) sized.width = sized.height = 1;
-  if (!sized.valid()) yaml.fail("invalid intrinsics (non-positive values)");
+  if (!sized.valid()) yaml.fail("invalid intrinsics (a zero focal length, or a size or depth scale not positive)");
   return c;
 }
 

@@ -83,7 +83,7 @@ double largestPixelShift(const Eigen::Isometry3d& moved, const Camera& c, double
   const double corner2 =
       0.25 * ((c.width / c.fx) * (c.width / c.fx) + (c.height / c.fy) * (c.height / c.fy));
   const double angle = logSO3(moved.linear()).norm();
-  return std::max(c.fx, c.fy) *
+  return std::max(std::abs(c.fx), std::abs(c.fy)) *
          (angle * (1.0 + corner2) + moved.translation().norm() / std::max(nearest, 0.1));
 }
 
