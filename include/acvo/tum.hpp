@@ -38,7 +38,9 @@ using Trajectory = std::vector<StampedPose>;
 // naming the file (and line number for a malformed line).
 std::vector<TumListEntry> readTumList(const std::string& path);
 
-// Reads associations.txt ("rgb_ts rgb_path depth_ts depth_path").
+// Reads associations.txt ("rgb_ts rgb_path depth_ts depth_path"; a line whose first path is in a
+// folder named depth* and whose second is not is read the other way round, depth first, as
+// ICL-NUIM's TUM-format archives have it).
 std::vector<TumAssociation> readAssociations(const std::string& path);
 
 // Nearest-timestamp association as TUM's associate.py does: candidate pairs with

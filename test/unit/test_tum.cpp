@@ -82,6 +82,15 @@ TEST(TumList, ReadsAssociations) {
   EXPECT_DOUBLE_EQ(a[0].depth.stamp, 1.004);
   EXPECT_EQ(a[0].depth.path, "depth/1.png");
 
+  // Depth first, as in ICL-NUIM's TUM-format archives: stamps that are frame numbers.
+  writeText(path, "0 depth/0.png 0 rgb/0.png\n1 depth/1.png 1 rgb/1.png\n");
+  const auto icl = acvo::readAssociations(path);
+  ASSERT_EQ(icl.size(), 2u);
+  EXPECT_EQ(icl[1].rgb.path, "rgb/1.png");
+  EXPECT_EQ(icl[1].depth.path, "depth/1.png");
+  EXPECT_DOUBLE_EQ(icl[1].rgb.stamp, 1.0);
+  EXPECT_EQ(icl[1].depth.stamp_text, "1");
+
   writeText(path, "1.0 rgb/1.png 1.0 depth/1.png\n2.0 rgb/2.png 2.0\n");
   const std::string why = errorOf([&] { acvo::readAssociations(path); });
   EXPECT_TRUE(contains(why, path + ":2")) << why;

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
+#include <utility>
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -98,14 +99,20 @@ std::vector<TumListEntry> readTumList(const std::string& path) {
 }
 
 std::vector<TumAssociation> readAssociations(const std::string& path) {
+  // A path in a folder whose name starts with "depth" (TUM's depth/) is a depth image's.
+  auto underDepth = [](const std::string& file) { return file.rfind("depth", 0) == 0; };
   std::vector<TumAssociation> associations;
   for (const Line& line : readDataLines(path)) {
     const auto f = splitFields(line.text);
     if (f.size() != 4) {
       malformed(path, line, "expected 'rgb_stamp rgb_path depth_stamp depth_path'");
     }
-    associations.push_back(
-        {{f[0], parseStamp(path, line, f[0]), f[1]}, {f[2], parseStamp(path, line, f[2]), f[3]}});
+    TumAssociation a{{f[0], parseStamp(path, line, f[0]), f[1]},
+                     {f[2], parseStamp(path, line, f[2]), f[3]}};
+    // Depth first, as ICL-NUIM's TUM-format archives list it ("0 depth/0.png 0 rgb/0.png") and
+    // as TUM's associate.py writes it when given depth.txt first.
+    if (underDepth(f[1]) && !underDepth(f[3])) std::swap(a.rgb, a.depth);
+    associations.push_back(std::move(a));
   }
   return associations;
 }
