@@ -18,7 +18,10 @@ struct DepthTraits;
 template <>
 struct DepthTraits<std::uint16_t> {
   static constexpr int cv_type = CV_16UC1;
-  static bool valid(std::uint16_t raw) { return raw != 0; }
+  // 0, and the largest value: the no-reading mark of 7-Scenes' depth (13 m in TUM's units, 65 m
+  // in millimetres, beyond every RGB-D camera's range).
+  static constexpr std::uint16_t kNoReading = 0xFFFF;
+  static bool valid(std::uint16_t raw) { return raw != 0 && raw != kNoReading; }
   static float toMeters(std::uint16_t raw, double units_per_metre) {
     return static_cast<float>(raw / units_per_metre);
   }
@@ -34,7 +37,7 @@ struct DepthTraits<float> {
 };
 
 // Converts a raw depth image (CV_16UC1 or CV_32FC1) to metres (CV_32FC1), with 0 for every
-// invalid pixel (raw 0, NaN, Inf, negative). `units_per_metre`: 5000 for TUM PNG, 1000 for
+// invalid pixel (raw 0 or 65535, NaN, Inf, negative). `units_per_metre`: 5000 for TUM PNG, 1000 for
 // 16UC1 millimetres, 1 for 32FC1 metres. Throws std::invalid_argument for other types.
 cv::Mat depthToMeters(const cv::Mat& raw, double units_per_metre);
 

@@ -49,10 +49,16 @@ TEST(Depth, TumPngMillimetresAndMetresGiveTheSameMetres) {
 }
 
 TEST(Depth, InvalidPixelsBecomeZero) {
-  cv::Mat raw16 = (cv::Mat_<std::uint16_t>(1, 2) << 0, 10000);
+  // 0, and 65535: 7-Scenes' mark of a pixel without a reading.
+  cv::Mat raw16 = (cv::Mat_<std::uint16_t>(1, 4) << 0, 10000, 65535, 65534);
+  for (double scale : {5000.0, 1000.0}) {
+    const cv::Mat out16 = acvo::depthToMeters(raw16, scale);
+    EXPECT_EQ(out16.at<float>(0, 0), 0.0f) << scale;
+    EXPECT_EQ(out16.at<float>(0, 2), 0.0f) << scale;
+  }
   const cv::Mat out16 = acvo::depthToMeters(raw16, 5000.0);
-  EXPECT_EQ(out16.at<float>(0, 0), 0.0f);
   EXPECT_FLOAT_EQ(out16.at<float>(0, 1), 2.0f);
+  EXPECT_FLOAT_EQ(out16.at<float>(0, 3), 65534.0f / 5000.0f);
 
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const float inf = std::numeric_limits<float>::infinity();

@@ -37,12 +37,15 @@ cv::Mat depthToMeters(const cv::Mat& raw, double units_per_metre) {
         break;
       }
       // Raw 0 (no depth) gives 0 and every other value a positive finite one: a product by the
-      // inverse scale, without the branches, which the compiler vectorises (the division per
-      // pixel of the generic path was a tenth of a frame's selection time).
+      // inverse scale and a select for the no-reading mark, which the compiler vectorises (the
+      // division per pixel of the generic path was a tenth of a frame's selection time).
+      constexpr std::uint16_t none = DepthTraits<std::uint16_t>::kNoReading;
       for (int v = 0; v < raw.rows; ++v) {
         const std::uint16_t* in = raw.ptr<std::uint16_t>(v);
         float* o = out.ptr<float>(v);
-        for (int u = 0; u < raw.cols; ++u) o[u] = static_cast<float>(in[u] * inv);
+        for (int u = 0; u < raw.cols; ++u) {
+          o[u] = in[u] == none ? 0.0f : static_cast<float>(in[u] * inv);
+        }
       }
       break;
     }
