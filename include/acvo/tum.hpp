@@ -57,17 +57,26 @@ Trajectory readTrajectory(const std::string& path);
 void writeTrajectory(const std::string& path, const Trajectory& trajectory,
                      const std::string& header_comment = "");
 
+// The TUM camera a folder's name gives: "fr1", "fr2" or "fr3" where the name holds freiburgN or
+// frN as a word of its own (TUM's archives unpack to rgbd_dataset_freiburg1_desk and the like);
+// "" otherwise.
+std::string tumCameraOfName(const std::string& folder_name);
+
 // A TUM-format dataset folder: rgb.txt, depth.txt, optional associations.txt,
 // optional groundtruth.txt, optional camera.yaml.
 class TumDataset {
  public:
-  // `camera`: empty = camera.yaml in the folder if present, else "default"; a name
-  // (fr1, fr2, fr3, default) or a path to a camera yaml overrides it. A camera yaml without the
-  // image size takes the first colour image's.
+  // `camera`: empty = camera.yaml in the folder if present, else the TUM camera the folder's name
+  // gives (tumCameraOfName: its calibrated intrinsics and, for fr1 and fr2, its lens), else
+  // "default"; a name (fr1, fr2, fr3, default) or a path to a camera yaml overrides it. A camera
+  // yaml without the image size takes the first colour image's.
   explicit TumDataset(const std::string& folder, const std::string& camera = "");
 
   const std::string& folder() const { return folder_; }
   const Camera& camera() const { return camera_; }
+  // Where camera() came from: "camera.yaml", "the folder's name (frN)", "default (no camera.yaml)",
+  // or the name or file given.
+  const std::string& cameraSource() const { return camera_source_; }
   const std::vector<TumAssociation>& frames() const { return frames_; }
   std::size_t size() const { return frames_.size(); }
   const std::optional<Trajectory>& groundtruth() const { return groundtruth_; }
@@ -88,6 +97,7 @@ class TumDataset {
  private:
   std::string folder_;
   Camera camera_;
+  std::string camera_source_;
   LensDistortion distortion_;
   cv::Mat undistort_x_, undistort_y_;  // raw pixel of each undistorted pixel; empty: none
   std::vector<TumAssociation> frames_;

@@ -102,6 +102,14 @@ int main(int argc, char** argv) {
                 << "carries that in full (--camera FILE gives a calibration; fr1, fr2 or fr3, "
                 << "TUM's)\n";
     }
+    if (data.cameraSource().rfind("the folder's name", 0) == 0) {
+      const acvo::Camera& c = data.camera();
+      std::cerr << "acvo_tum: note: no camera.yaml; " << data.cameraSource()
+                << " gives TUM's calibrated intrinsics (fx " << c.fx << ", fy " << c.fy << ", cx "
+                << c.cx << ", cy " << c.cy << ")"
+                << (data.distortion().any() ? " and lens" : "")
+                << " (--camera default or a camera file for others)\n";
+    }
     if (data.camera().mirrored()) {
       std::cerr << "acvo_tum: note: a negative focal length (fx " << data.camera().fx << ", fy "
                 << data.camera().fy << "): that image axis runs against the optical frame's, as in "

@@ -309,6 +309,32 @@ TEST(TumDataset, DefaultCameraWithoutYaml) {
   const acvo::TumDataset dataset(data.dir.string());
   EXPECT_DOUBLE_EQ(dataset.camera().fx, 525.0);
   EXPECT_EQ(dataset.camera().width, 640);
+  EXPECT_EQ(dataset.cameraSource(), "default (no camera.yaml)");
+}
+
+TEST(TumDataset, TheFolderNameSaysWhichTumCamera) {
+  EXPECT_EQ(acvo::tumCameraOfName("rgbd_dataset_freiburg1_desk"), "fr1");
+  EXPECT_EQ(acvo::tumCameraOfName("rgbd_dataset_freiburg2_pioneer_360"), "fr2");
+  EXPECT_EQ(acvo::tumCameraOfName("tum_fr3_teddy200"), "fr3");
+  EXPECT_EQ(acvo::tumCameraOfName("FR2-xyz"), "fr2");
+  for (const char* other : {"kitchen7s_dev", "fr4_room", "fr12", "africa3", "freiburg", ""}) {
+    EXPECT_EQ(acvo::tumCameraOfName(other), "") << other;
+  }
+
+  // Without camera.yaml, the named camera's calibrated intrinsics and lens (a trailing '/' too).
+  const TinyDataset tiny("rgbd_dataset_freiburg1_tiny");
+  fs::remove(tiny.dir / "camera.yaml");
+  for (const std::string& path : {tiny.dir.string(), tiny.dir.string() + "/"}) {
+    const acvo::TumDataset dataset(path);
+    EXPECT_DOUBLE_EQ(dataset.camera().fx, 517.3) << path;
+    EXPECT_TRUE(dataset.distortion().any()) << path;
+    EXPECT_EQ(dataset.cameraSource(), "the folder's name (fr1)") << path;
+  }
+  // camera.yaml, or a camera given, comes first.
+  writeText(tiny.dir / "camera.yaml", "fx: 4.5\nfy: 4.5\ncx: 1.5\ncy: 1.0\nwidth: 4\nheight: 3\n");
+  EXPECT_DOUBLE_EQ(acvo::TumDataset(tiny.dir.string()).camera().fx, 4.5);
+  EXPECT_EQ(acvo::TumDataset(tiny.dir.string()).cameraSource(), "camera.yaml");
+  EXPECT_DOUBLE_EQ(acvo::TumDataset(tiny.dir.string(), "fr3").camera().fx, 535.4);
 }
 
 TEST(TumDataset, BadFilesAreNamed) {

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <stdexcept>
 #include <utility>
 
@@ -178,18 +179,34 @@ void writeTrajectory(const std::string& path, const Trajectory& trajectory,
   if (!out) throw std::runtime_error("error while writing " + path);
 }
 
+std::string tumCameraOfName(const std::string& folder_name) {
+  static const std::regex tum("(^|[^a-z0-9])(freiburg|fr)([123])([^0-9]|$)", std::regex::icase);
+  std::smatch match;
+  return std::regex_search(folder_name, match, tum) ? "fr" + match[3].str() : std::string();
+}
+
 TumDataset::TumDataset(const std::string& folder, const std::string& camera) : folder_(folder) {
   const fs::path dir(folder);
   if (!fs::is_directory(dir)) throw std::runtime_error("dataset folder " + folder + " not found");
 
+  camera_source_ = camera;
   if (camera.empty()) {
     const fs::path yaml = dir / "camera.yaml";
+    fs::path name = fs::absolute(dir).lexically_normal();
+    if (name.filename().empty()) name = name.parent_path();  // a path ending in '/'
+    const std::string named = tumCameraOfName(name.filename().string());
     if (fs::exists(yaml)) {
       const CameraFile file = readCameraFile(yaml.string());
       camera_ = file.camera;
       distortion_ = file.distortion;
+      camera_source_ = "camera.yaml";
+    } else if (!named.empty()) {
+      camera_ = cameraByName(named);
+      distortion_ = distortionByName(named);
+      camera_source_ = "the folder's name (" + named + ")";
     } else {
       camera_ = cameraByName("default");
+      camera_source_ = "default (no camera.yaml)";
     }
   } else if (camera == "fr1" || camera == "fr2" || camera == "fr3" || camera == "default") {
     camera_ = cameraByName(camera);
