@@ -38,8 +38,8 @@ using Trajectory = std::vector<StampedPose>;
 // naming the file (and line number for a malformed line).
 std::vector<TumListEntry> readTumList(const std::string& path);
 
-// Reads associations.txt ("rgb_ts rgb_path depth_ts depth_path"; a line whose first path is in a
-// folder named depth* and whose second is not is read the other way round, depth first, as
+// Reads associations.txt ("rgb_ts rgb_path depth_ts depth_path"; a line whose first file lies in
+// a folder named depth* and whose second does not is read the other way round, depth first, as
 // ICL-NUIM's TUM-format archives have it).
 std::vector<TumAssociation> readAssociations(const std::string& path);
 
@@ -58,8 +58,8 @@ void writeTrajectory(const std::string& path, const Trajectory& trajectory,
                      const std::string& header_comment = "");
 
 // The TUM camera a folder's name gives: "fr1", "fr2" or "fr3" where the name holds freiburgN or
-// frN as a word of its own (TUM's archives unpack to rgbd_dataset_freiburg1_desk and the like);
-// "" otherwise.
+// frN, N not followed by a digit and the word not preceded by a letter or digit (TUM's archives
+// unpack to rgbd_dataset_freiburg1_desk and the like); "" otherwise.
 std::string tumCameraOfName(const std::string& folder_name);
 
 // A TUM-format dataset folder: rgb.txt, depth.txt, optional associations.txt,
@@ -77,6 +77,8 @@ class TumDataset {
   // Where camera() came from: "camera.yaml", "the folder's name (frN)", "default (no camera.yaml)",
   // or the name or file given.
   const std::string& cameraSource() const { return camera_source_; }
+  // The TUM camera the folder's name gave ("fr1", "fr2", "fr3"), "" where it did not decide.
+  const std::string& namedCamera() const { return named_camera_; }
   const std::vector<TumAssociation>& frames() const { return frames_; }
   std::size_t size() const { return frames_.size(); }
   const std::optional<Trajectory>& groundtruth() const { return groundtruth_; }
@@ -98,6 +100,7 @@ class TumDataset {
   std::string folder_;
   Camera camera_;
   std::string camera_source_;
+  std::string named_camera_;
   LensDistortion distortion_;
   cv::Mat undistort_x_, undistort_y_;  // raw pixel of each undistorted pixel; empty: none
   std::vector<TumAssociation> frames_;

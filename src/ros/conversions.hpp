@@ -3,6 +3,7 @@
 // returns a value with an empty `problem` on success or a sentence saying what is wrong.
 #pragma once
 
+#include <cmath>
 #include <string>
 #include <variant>
 
@@ -51,7 +52,10 @@ struct IntrinsicsOverride {
   std::string camera;
   double fx = 0.0, fy = 0.0, cx = 0.0, cy = 0.0;
 
-  bool explicitValues() const { return fx != 0.0 && fy != 0.0 && cx > 0.0 && cy > 0.0; }
+  bool explicitValues() const {
+    return std::isfinite(fx) && fx != 0.0 && std::isfinite(fy) && fy != 0.0 && cx > 0.0 &&
+           cy > 0.0 && std::isfinite(cx) && std::isfinite(cy);
+  }
   bool named() const { return !camera.empty() && camera != "info"; }
   bool fromCameraInfo() const { return !explicitValues() && !named(); }
   // Empty when consistent; otherwise says what is wrong (unknown name, partial fx..cy).
@@ -65,7 +69,8 @@ struct CameraResult {
 // Intrinsics of a width x height colour image: explicit override, else the named camera
 // (scaled when the image is not 640x480), else CameraInfo's projection matrix P through
 // image_geometry::PinholeCameraModel (binning and ROI applied; K when P is all zero), whose
-// size after binning and ROI must match the image and whose focal lengths must be positive.
+// size after binning and ROI must match the image and whose focal lengths must be finite and not
+// zero (a negative one is a mirrored axis, as acvo::Camera takes it).
 CameraResult cameraFor(const sensor_msgs::CameraInfo& info, int width, int height,
                        const IntrinsicsOverride& override_intrinsics);
 

@@ -151,7 +151,7 @@ RayCast rayCast(const Scene& scene, const Camera& camera, const Eigen::Isometry3
   const RayCaster caster(scene, pose.translation());
   const std::vector<PixelRect> bounds = primitiveBounds(scene, camera, pose);
   const Eigen::Matrix3d R = pose.linear();
-  const double focal = std::sqrt(camera.fx * camera.fy);
+  const double focal = std::sqrt(std::abs(camera.fx * camera.fy));  // (negative: a mirrored axis)
   tbb::parallel_for(tbb::blocked_range<int>(0, camera.height),
                     [&](const tbb::blocked_range<int>& r) {
                       std::vector<int> in_row, candidates(bounds.size());

@@ -179,7 +179,7 @@ cv::Mat depthToPng16(const cv::Mat& depth_m, double depth_scale) {
     auto* o = out.ptr<std::uint16_t>(v);
     for (int u = 0; u < depth_m.cols; ++u) {
       const double raw = std::round(static_cast<double>(in[u]) * depth_scale);
-      o[u] = raw > 0 && raw <= 65535 ? static_cast<std::uint16_t>(raw) : 0;
+      o[u] = raw > 0 && raw < 65535 ? static_cast<std::uint16_t>(raw) : 0;  // 65535: no reading
     }
   }
   return out;

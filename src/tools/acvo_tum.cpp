@@ -102,7 +102,7 @@ int main(int argc, char** argv) {
                 << "carries that in full (--camera FILE gives a calibration; fr1, fr2 or fr3, "
                 << "TUM's)\n";
     }
-    if (data.cameraSource().rfind("the folder's name", 0) == 0) {
+    if (!data.namedCamera().empty()) {
       const acvo::Camera& c = data.camera();
       std::cerr << "acvo_tum: note: no camera.yaml; " << data.cameraSource()
                 << " gives TUM's calibrated intrinsics (fx " << c.fx << ", fy " << c.fy << ", cx "

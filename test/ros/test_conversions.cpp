@@ -121,14 +121,14 @@ TEST(DecodeDepth, RejectsAStepThatIsNotAWholeNumberOfElements) {
 
 TEST(DecodeDepth, MillimetresAndMetresGiveTheSameMetres) {
   sensor_msgs::Image mm = image(enc::TYPE_16UC1, 3, 1, 2);
-  const std::uint16_t raw[3] = {1500, 0, 65535};
+  const std::uint16_t raw[3] = {1500, 0, 65534};  // (65535: no reading, as 0)
   std::memcpy(mm.data.data(), raw, sizeof raw);
   const DepthImage a = decodeDepth(mm);
   ASSERT_EQ(a.problem, "");
   EXPECT_DOUBLE_EQ(a.units_per_metre, 1000.0);
   EXPECT_FLOAT_EQ(a.metres.at<float>(0, 0), 1.5f);
   EXPECT_EQ(a.metres.at<float>(0, 1), 0.0f);
-  EXPECT_FLOAT_EQ(a.metres.at<float>(0, 2), 65.535f);
+  EXPECT_FLOAT_EQ(a.metres.at<float>(0, 2), 65.534f);
 
   sensor_msgs::Image m = image(enc::TYPE_32FC1, 3, 1, 4);
   const float raw_m[3] = {1.5f, std::nanf(""), -1.0f};

@@ -322,9 +322,10 @@ class Client {
   RgbdImage flatColour(int k) {
     return {cv::Mat(frame(k).rgb.size(), CV_8UC3, cv::Scalar(128, 128, 128)), frame(k).depth};
   }
-  // Frame k's colour with depth beyond the range everywhere (100 m; 65.5 m in 16UC1).
+  // Frame k's colour with depth beyond the range everywhere (60 m: under 16UC1's 65535, which is
+  // no reading).
   RgbdImage farDepth(int k) {
-    return {frame(k).rgb, cv::Mat(frame(k).depth.size(), CV_32FC1, cv::Scalar(100.0f))};
+    return {frame(k).rgb, cv::Mat(frame(k).depth.size(), CV_32FC1, cv::Scalar(60.0f))};
   }
   // Uniform random colour and depth (0.5-4 m): a frame of noise.
   RgbdImage noise(unsigned seed) {

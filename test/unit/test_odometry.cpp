@@ -91,17 +91,18 @@ TEST(Odometry, FirstFrameThenTracksAnExactSequence) {
   }
 }
 
-// The frame mirrored about its horizontal (flip_code 0) or vertical (1) axis, with the camera that
-// says so: that axis's focal length negated, its centre mirrored. Each pixel back-projects to the
-// point it did before.
+// The frame mirrored as cv::flip does, about its horizontal axis (flip_code 0), its vertical one
+// (1) or both (-1), with the camera that says so: the mirrored axes' focal lengths negated, their
+// centres mirrored. Each pixel back-projects to the point it did before.
 Frame mirroredFrame(const Frame& f, int flip_code) {
   Frame out = f;
   cv::flip(f.color, out.color, flip_code);
   cv::flip(f.depth, out.depth, flip_code);
-  if (flip_code == 0) {
+  if (flip_code <= 0) {
     out.camera.fy = -f.camera.fy;
     out.camera.cy = (f.camera.height - 1) - f.camera.cy;
-  } else {
+  }
+  if (flip_code != 0) {
     out.camera.fx = -f.camera.fx;
     out.camera.cx = (f.camera.width - 1) - f.camera.cx;
   }
@@ -109,21 +110,22 @@ Frame mirroredFrame(const Frame& f, int flip_code) {
 }
 
 // A camera whose image axis is mirrored, as in ICL-NUIM's published intrinsics (fy -480, its
-// renderer's y axis pointing up), is tracked as the same frames unmirrored are: to a tenth of a
-// millimetre on this rendered room (the largest errors over the 7 frames: 0.18 mm and 0.004 deg
-// as rendered, 0.19 mm and 0.005 deg upside down, 0.14 mm and 0.003 deg mirrored left to right).
+// renderer's y axis pointing up), is tracked as the same frames unmirrored are, on this rendered
+// room. The largest errors over the 7 frames: 0.18 mm and 0.0043 deg as rendered, 0.19 mm and
+// 0.0047 deg upside down, 0.14 mm and 0.0034 deg left to right, 0.24 mm and 0.0066 deg both.
 TEST(Odometry, AMirroredImageAxisIsANegativeFocalLength) {
   synth::SequenceOptions o;
   o.frames = 8;
   o.speed = 0.5;
   const synth::SynthSequence seq(o);
-  for (int flip_code : {-2, 0, 1}) {  // -2: as rendered
+  for (int flip_code : {-2, 0, 1, -1}) {  // -2: as rendered
     Odometry odo;
     odo.reset(seq.poses()[0]);
     double worst_mm = 0.0, worst_deg = 0.0;
     for (int i = 0; i < seq.size(); ++i) {
       const Frame frame = seq.frame(i).toFrame();
-      const OdometryResult r = odo.process(flip_code < -1 ? frame : mirroredFrame(frame, flip_code));
+      const Frame input = flip_code < -1 ? frame : mirroredFrame(frame, flip_code);
+      const OdometryResult r = odo.process(input);
       if (i == 0) {
         EXPECT_EQ(r.tracking, Tracking::kFirstFrame) << r.message;
         continue;
@@ -136,8 +138,8 @@ TEST(Odometry, AMirroredImageAxisIsANegativeFocalLength) {
     }
     std::printf("flip %d: at most %.2f mm and %.4f deg off the truth\n", flip_code, worst_mm,
                 worst_deg);
-    EXPECT_LT(worst_mm, 0.3) << "flip " << flip_code;
-    EXPECT_LT(worst_deg, 0.008) << "flip " << flip_code;
+    EXPECT_LT(worst_mm, 0.35) << "flip " << flip_code;
+    EXPECT_LT(worst_deg, 0.01) << "flip " << flip_code;
   }
 }
 

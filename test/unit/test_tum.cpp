@@ -83,11 +83,14 @@ TEST(TumList, ReadsAssociations) {
   EXPECT_EQ(a[0].depth.path, "depth/1.png");
 
   // Depth first, as in ICL-NUIM's TUM-format archives: stamps that are frame numbers.
-  writeText(path, "0 depth/0.png 0 rgb/0.png\n1 depth/1.png 1 rgb/1.png\n");
+  writeText(path, "0 depth/0.png 0 rgb/0.png\n1 ./depth/1.png 1 rgb/1.png\n");
   const auto icl = acvo::readAssociations(path);
   ASSERT_EQ(icl.size(), 2u);
   EXPECT_EQ(icl[1].rgb.path, "rgb/1.png");
-  EXPECT_EQ(icl[1].depth.path, "depth/1.png");
+  EXPECT_EQ(icl[1].depth.path, "./depth/1.png");
+  // Not a folder: read as listed.
+  writeText(path, "1 depth.png 1 rgb/1.png\n");
+  EXPECT_EQ(acvo::readAssociations(path)[0].rgb.path, "depth.png");
   EXPECT_DOUBLE_EQ(icl[1].rgb.stamp, 1.0);
   EXPECT_EQ(icl[1].depth.stamp_text, "1");
 
@@ -329,6 +332,7 @@ TEST(TumDataset, TheFolderNameSaysWhichTumCamera) {
     EXPECT_DOUBLE_EQ(dataset.camera().fx, 517.3) << path;
     EXPECT_TRUE(dataset.distortion().any()) << path;
     EXPECT_EQ(dataset.cameraSource(), "the folder's name (fr1)") << path;
+    EXPECT_EQ(dataset.namedCamera(), "fr1") << path;
   }
   // camera.yaml, or a camera given, comes first.
   writeText(tiny.dir / "camera.yaml", "fx: 4.5\nfy: 4.5\ncx: 1.5\ncy: 1.0\nwidth: 4\nheight: 3\n");

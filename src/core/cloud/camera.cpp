@@ -53,7 +53,7 @@ bool nominalIntrinsics(const Camera& camera, const LensDistortion& distortion) {
     return std::any_of(kShifts.begin(), kShifts.end(),
                        [&](double shift) { return std::abs(c - 0.5 * (size + shift)) < 1e-6; });
   };
-  return !distortion.any() && std::abs(camera.fx - camera.fy) < 1e-6 &&
+  return !distortion.any() && std::abs(std::abs(camera.fx) - std::abs(camera.fy)) < 1e-6 &&
          centred(camera.cx, camera.width) && centred(camera.cy, camera.height);
 }
 
@@ -127,7 +127,9 @@ Camera intrinsicsOf(const CameraYaml& yaml) {
   yaml.get("depth_scale", c.depth_scale, false);
   Camera sized = c;
   if (sized.width == 0 && sized.height == 0) sized.width = sized.height = 1;
-  if (!sized.valid()) yaml.fail("invalid intrinsics (a zero focal length, or a size or depth scale not positive)");
+  if (!sized.valid()) {
+    yaml.fail("invalid intrinsics (a zero focal length, or a size or depth scale not positive)");
+  }
   return c;
 }
 

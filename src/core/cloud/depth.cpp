@@ -36,9 +36,9 @@ cv::Mat depthToMeters(const cv::Mat& raw, double units_per_metre) {
         convert<std::uint16_t>(raw, units_per_metre, out);  // some values beyond float
         break;
       }
-      // Raw 0 (no depth) gives 0 and every other value a positive finite one: a product by the
-      // inverse scale and a select for the no-reading mark, which the compiler vectorises (the
-      // division per pixel of the generic path was a tenth of a frame's selection time).
+      // Raw 0 and 65535 (no reading) give 0 and every other value a positive finite one: a product
+      // by the inverse scale and a select for the mark, which the compiler vectorises (the division
+      // per pixel of the generic path was a tenth of a frame's selection time).
       constexpr std::uint16_t none = DepthTraits<std::uint16_t>::kNoReading;
       for (int v = 0; v < raw.rows; ++v) {
         const std::uint16_t* in = raw.ptr<std::uint16_t>(v);

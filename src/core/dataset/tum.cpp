@@ -100,8 +100,10 @@ std::vector<TumListEntry> readTumList(const std::string& path) {
 }
 
 std::vector<TumAssociation> readAssociations(const std::string& path) {
-  // A path in a folder whose name starts with "depth" (TUM's depth/) is a depth image's.
-  auto underDepth = [](const std::string& file) { return file.rfind("depth", 0) == 0; };
+  // A file in a folder whose name starts with "depth" (TUM's depth/) is a depth image.
+  auto underDepth = [](const std::string& file) {
+    return fs::path(file).parent_path().filename().string().rfind("depth", 0) == 0;
+  };
   std::vector<TumAssociation> associations;
   for (const Line& line : readDataLines(path)) {
     const auto f = splitFields(line.text);
@@ -204,6 +206,7 @@ TumDataset::TumDataset(const std::string& folder, const std::string& camera) : f
       camera_ = cameraByName(named);
       distortion_ = distortionByName(named);
       camera_source_ = "the folder's name (" + named + ")";
+      named_camera_ = named;
     } else {
       camera_ = cameraByName("default");
       camera_source_ = "default (no camera.yaml)";
