@@ -74,9 +74,6 @@ class TumDataset {
 
   const std::string& folder() const { return folder_; }
   const Camera& camera() const { return camera_; }
-  // Where camera() came from: "camera.yaml", "the folder's name (frN)", "default (no camera.yaml)",
-  // or the name or file given.
-  const std::string& cameraSource() const { return camera_source_; }
   // The TUM camera the folder's name gave ("fr1", "fr2", "fr3"), "" where it did not decide.
   const std::string& namedCamera() const { return named_camera_; }
   const std::vector<TumAssociation>& frames() const { return frames_; }
@@ -99,7 +96,6 @@ class TumDataset {
  private:
   std::string folder_;
   Camera camera_;
-  std::string camera_source_;
   std::string named_camera_;
   LensDistortion distortion_;
   cv::Mat undistort_x_, undistort_y_;  // raw pixel of each undistorted pixel; empty: none

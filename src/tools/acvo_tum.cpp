@@ -104,8 +104,8 @@ int main(int argc, char** argv) {
     }
     if (!data.namedCamera().empty()) {
       const acvo::Camera& c = data.camera();
-      std::cerr << "acvo_tum: note: no camera.yaml; " << data.cameraSource()
-                << " gives TUM's calibrated intrinsics (fx " << c.fx << ", fy " << c.fy << ", cx "
+      std::cerr << "acvo_tum: note: no camera.yaml; the folder's name (" << data.namedCamera()
+                << ") gives TUM's calibrated intrinsics (fx " << c.fx << ", fy " << c.fy << ", cx "
                 << c.cx << ", cy " << c.cy << ")"
                 << (data.distortion().any() ? " and lens" : "")
                 << " (--camera default or a camera file for others)\n";

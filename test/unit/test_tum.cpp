@@ -88,11 +88,11 @@ TEST(TumList, ReadsAssociations) {
   ASSERT_EQ(icl.size(), 2u);
   EXPECT_EQ(icl[1].rgb.path, "rgb/1.png");
   EXPECT_EQ(icl[1].depth.path, "./depth/1.png");
+  EXPECT_DOUBLE_EQ(icl[1].rgb.stamp, 1.0);
+  EXPECT_EQ(icl[1].depth.stamp_text, "1");
   // Not a folder: read as listed.
   writeText(path, "1 depth.png 1 rgb/1.png\n");
   EXPECT_EQ(acvo::readAssociations(path)[0].rgb.path, "depth.png");
-  EXPECT_DOUBLE_EQ(icl[1].rgb.stamp, 1.0);
-  EXPECT_EQ(icl[1].depth.stamp_text, "1");
 
   writeText(path, "1.0 rgb/1.png 1.0 depth/1.png\n2.0 rgb/2.png 2.0\n");
   const std::string why = errorOf([&] { acvo::readAssociations(path); });
@@ -312,7 +312,7 @@ TEST(TumDataset, DefaultCameraWithoutYaml) {
   const acvo::TumDataset dataset(data.dir.string());
   EXPECT_DOUBLE_EQ(dataset.camera().fx, 525.0);
   EXPECT_EQ(dataset.camera().width, 640);
-  EXPECT_EQ(dataset.cameraSource(), "default (no camera.yaml)");
+  EXPECT_EQ(dataset.namedCamera(), "");
 }
 
 TEST(TumDataset, TheFolderNameSaysWhichTumCamera) {
@@ -331,13 +331,12 @@ TEST(TumDataset, TheFolderNameSaysWhichTumCamera) {
     const acvo::TumDataset dataset(path);
     EXPECT_DOUBLE_EQ(dataset.camera().fx, 517.3) << path;
     EXPECT_TRUE(dataset.distortion().any()) << path;
-    EXPECT_EQ(dataset.cameraSource(), "the folder's name (fr1)") << path;
     EXPECT_EQ(dataset.namedCamera(), "fr1") << path;
   }
   // camera.yaml, or a camera given, comes first.
   writeText(tiny.dir / "camera.yaml", "fx: 4.5\nfy: 4.5\ncx: 1.5\ncy: 1.0\nwidth: 4\nheight: 3\n");
   EXPECT_DOUBLE_EQ(acvo::TumDataset(tiny.dir.string()).camera().fx, 4.5);
-  EXPECT_EQ(acvo::TumDataset(tiny.dir.string()).cameraSource(), "camera.yaml");
+  EXPECT_EQ(acvo::TumDataset(tiny.dir.string()).namedCamera(), "");
   EXPECT_DOUBLE_EQ(acvo::TumDataset(tiny.dir.string(), "fr3").camera().fx, 535.4);
 }
 

@@ -191,25 +191,18 @@ TumDataset::TumDataset(const std::string& folder, const std::string& camera) : f
   const fs::path dir(folder);
   if (!fs::is_directory(dir)) throw std::runtime_error("dataset folder " + folder + " not found");
 
-  camera_source_ = camera;
   if (camera.empty()) {
     const fs::path yaml = dir / "camera.yaml";
-    fs::path name = fs::absolute(dir).lexically_normal();
-    if (name.filename().empty()) name = name.parent_path();  // a path ending in '/'
-    const std::string named = tumCameraOfName(name.filename().string());
     if (fs::exists(yaml)) {
       const CameraFile file = readCameraFile(yaml.string());
       camera_ = file.camera;
       distortion_ = file.distortion;
-      camera_source_ = "camera.yaml";
-    } else if (!named.empty()) {
-      camera_ = cameraByName(named);
-      distortion_ = distortionByName(named);
-      camera_source_ = "the folder's name (" + named + ")";
-      named_camera_ = named;
     } else {
-      camera_ = cameraByName("default");
-      camera_source_ = "default (no camera.yaml)";
+      fs::path name = fs::absolute(dir).lexically_normal();
+      if (name.filename().empty()) name = name.parent_path();  // a path ending in '/'
+      named_camera_ = tumCameraOfName(name.filename().string());
+      camera_ = cameraByName(named_camera_.empty() ? "default" : named_camera_);
+      distortion_ = distortionByName(named_camera_);
     }
   } else if (camera == "fr1" || camera == "fr2" || camera == "fr3" || camera == "default") {
     camera_ = cameraByName(camera);
