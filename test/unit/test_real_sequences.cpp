@@ -1,0 +1,164 @@
+// Whole sequences of the shared real Kinect frames (../shared/data: skipped where absent): the
+// default engine and the paper's A-CVO and CVO on 7-Scenes' kitchen and TUM fr3/teddy, against
+// their measured figures and the authors' code. Bounds are the measured figures with a margin
+// (docs/accuracy.md).
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+
+#include <gtest/gtest.h>
+
+#include "acvo/tum.hpp"
+#include "sequence_support.hpp"
+#include "test_support.hpp"
+
+namespace acvo {
+namespace {
+
+using namespace acvo::test;  // the sequences' helpers (sequence_support.hpp)
+
+TEST(Sequences, RpeOnRealKinectFrames) {
+  const auto shared = test::sharedDataDir();
+  if (shared.empty()) GTEST_SKIP() << "../shared/data not present";
+  const TumDataset data((shared / "kitchen7s_dev").string());
+  ASSERT_TRUE(data.groundtruth());
+  Trajectory gt;
+  for (std::size_t i = 0; i < data.size(); ++i) {
+    const auto& e = data.frames()[i].rgb;
+    // Ground truth at the frame stamps (this dataset has one pose per frame).
+    gt.push_back({e.stamp_text, e.stamp, (*data.groundtruth())[i].pose});
+  }
+  const auto frame_at = [&](int i) { return data.loadFrame(std::size_t(i)); };
+  const auto runs = runAll(int(data.size()), frame_at, gt);
+  Params denser;
+  denser.selection.reference_density = 2.0;
+  const PolicyRun dense = runPolicies<1>({denser}, int(data.size()), frame_at, gt)[0];
+  for (int p = 0; p < 3; ++p) {
+    std::printf("  kitchen7s_dev %-14s RPE %.4f m/s %.3f deg/s, %d lost\n", kRunNames[p],
+                runs[p].rpe.trans.rmse, runs[p].rpe.rot_deg.rmse, runs[p].lost);
+  }
+  std::printf("  kitchen7s_dev reference_density 2 RPE %.4f m/s %.3f deg/s, %d lost\n",
+              dense.rpe.trans.rmse, dense.rpe.rot_deg.rmse, dense.lost);
+  // Measured 0.0321 m/s, 1.868 deg/s (default: its colour found unregistered and resampled,
+  // docs/accuracy.md, fifteenth round); paper.yaml 0.0628 m/s, 4.479 deg/s; cvo.yaml 0.0893,
+  // 5.474. Bounds 1.1x. 7-Scenes colour and depth come from two unregistered cameras.
+  EXPECT_EQ(runs[0].lost, 0);
+  EXPECT_LT(runs[0].rpe.trans.rmse, 0.0353);
+  EXPECT_LT(runs[0].rpe.rot_deg.rmse, 2.05);
+  EXPECT_EQ(runs[1].lost, 0);
+  EXPECT_LT(runs[1].rpe.trans.rmse, 0.07);
+  EXPECT_LT(runs[1].rpe.rot_deg.rmse, 5.0);
+  EXPECT_EQ(runs[2].lost, 0);
+  // A keyframe cloud twice as dense as the registered ones (selection.reference_density 2):
+  // measured 0.0236 m/s, 1.669 deg/s, 0.73x and 0.89x the default's. Bounds 1.1x.
+  EXPECT_EQ(dense.lost, 0);
+  EXPECT_LT(dense.rpe.trans.rmse, 0.026);
+  EXPECT_LT(dense.rpe.rot_deg.rmse, 1.83);
+  EXPECT_LT(dense.rpe.trans.rmse, 0.85 * runs[0].rpe.trans.rmse);
+}
+
+// TUM fr3/teddy (200 frames, hand-held, up to 100 deg/s) with motion-capture ground truth: the
+// default engine within a margin of its measured figures, nothing lost, and well below the
+// drift of the same engine registering frame to frame. (OpenCV's RgbdOdometry set up as its
+// TUM sample, at 10 m, does better here: 0.0104 m/s, 0.496 deg/s; docs/accuracy.md.)
+TEST(Sequences, RealHandHeldMotionIsTrackedWithoutLossOrDrift) {
+  const auto shared = test::sharedDataDir();
+  if (shared.empty()) GTEST_SKIP() << "../shared/data not present";
+  const TumDataset data((shared / "tum_fr3_teddy200").string());
+  ASSERT_TRUE(data.groundtruth());
+  const Trajectory& gt = *data.groundtruth();
+  // Start at the ground-truth pose nearest the first frame (motion capture runs at 100 Hz).
+  const double t0 = data.frames().front().rgb.stamp;
+  const auto nearest = std::min_element(gt.begin(), gt.end(), [t0](const auto& a, const auto& b) {
+    return std::abs(a.stamp - t0) < std::abs(b.stamp - t0);
+  });
+  // The default (keyframes), the same engine frame to frame, and keyframe clouds twice as dense
+  // as the registered ones, on the same frames.
+  std::array<Odometry, 3> odo;
+  Params previous_frame;
+  previous_frame.odometry.reference = Reference::kPreviousFrame;
+  odo[1] = Odometry(previous_frame);
+  Params denser;
+  denser.selection.reference_density = 2.0;
+  odo[2] = Odometry(denser);
+  std::array<Trajectory, 3> est;
+  std::array<int, 3> lost = {0, 0, 0};
+  for (int k = 0; k < 3; ++k) odo[k].reset(nearest->pose);
+  for (std::size_t i = 0; i < data.size(); ++i) {
+    const Frame frame = data.loadFrame(i);
+    const auto& e = data.frames()[i].rgb;
+    for (int k = 0; k < 3; ++k) {
+      const OdometryResult r = odo[k].process(frame);
+      lost[k] += r.tracking == Tracking::kLost;
+      est[k].push_back({e.stamp_text, e.stamp, r.pose});
+    }
+  }
+  const RpeResult rpe = computeRpe(gt, est[0]);
+  const double ate = computeAte(gt, est[0]).trans.rmse;
+  const double ate_previous = computeAte(gt, est[1]).trans.rmse;
+  std::printf(
+      "  tum_fr3_teddy200 default RPE %.4f m/s %.3f deg/s, ATE %.4f m (frame to frame "
+      "%.4f m), %d lost\n",
+      rpe.trans.rmse, rpe.rot_deg.rmse, ate, ate_previous, lost[0]);
+  // Measured 0.0059 m/s, 0.470 deg/s; ATE 0.0061 m against 0.0154 m frame to frame (the kernel
+  // alone: 0.0086, 0.579, ATE 0.0105; max_depth 4: 0.0159, 1.066, ATE 0.0185). Bounds 1.3x.
+  EXPECT_EQ(lost[0], 0);
+  EXPECT_LT(rpe.trans.rmse, 0.0077);
+  EXPECT_LT(rpe.rot_deg.rmse, 0.611);
+  // Keyframes against drift: at most 0.7 of the frame-to-frame ATE (the target).
+  EXPECT_LT(ate, 0.7 * ate_previous);
+  // The denser keyframe clouds (selection.reference_density 2): measured 0.0054 m/s, 0.459
+  // deg/s. Bounds 1.1x.
+  const RpeResult dense = computeRpe(gt, est[2]);
+  std::printf("  tum_fr3_teddy200 reference_density 2 RPE %.4f m/s %.3f deg/s, %d lost\n",
+              dense.trans.rmse, dense.rot_deg.rmse, lost[2]);
+  EXPECT_EQ(lost[2], 0);
+  EXPECT_LT(dense.trans.rmse, 0.0060);
+  EXPECT_LT(dense.rot_deg.rmse, 0.506);
+}
+
+// The paper's A-CVO (config/paper.yaml) and CVO (config/cvo.yaml) against the authors' public
+// code, built and run on the same 193 teddy frames: A-CVO 0.0957 m/s, 5.78 deg/s; CVO 0.111 m/s,
+// 6.45 deg/s. Each must be within 5% of those in both, nothing lost.
+TEST(Sequences, PaperConfigsReproduceTheAuthorsCodeOnTeddy) {
+  const auto shared = test::sharedDataDir();
+  if (shared.empty()) GTEST_SKIP() << "../shared/data not present";
+  const TumDataset data((shared / "tum_fr3_teddy200").string());
+  ASSERT_TRUE(data.groundtruth());
+  const Trajectory& gt = *data.groundtruth();
+  const double t0 = data.frames().front().rgb.stamp;
+  const auto nearest = std::min_element(gt.begin(), gt.end(), [t0](const auto& a, const auto& b) {
+    return std::abs(a.stamp - t0) < std::abs(b.stamp - t0);
+  });
+  std::array<Odometry, 2> odo = {Odometry(paperParams()), Odometry(cvoParams())};
+  std::array<Trajectory, 2> est;
+  std::array<int, 2> lost = {0, 0};
+  for (int k = 0; k < 2; ++k) odo[k].reset(nearest->pose);
+  for (std::size_t i = 0; i < data.size(); ++i) {
+    const Frame frame = data.loadFrame(i);
+    const auto& e = data.frames()[i].rgb;
+    for (int k = 0; k < 2; ++k) {
+      const OdometryResult r = odo[k].process(frame);
+      lost[k] += r.tracking == Tracking::kLost;
+      est[k].push_back({e.stamp_text, e.stamp, r.pose});
+    }
+  }
+  const char* names[] = {"paper.yaml (A-CVO)", "cvo.yaml (CVO)"};
+  const double authors[2][2] = {{0.0957, 5.78}, {0.111, 6.45}};
+  for (int k = 0; k < 2; ++k) {
+    const RpeResult rpe = computeRpe(gt, est[k]);
+    const double rt = rpe.trans.rmse / authors[k][0], rr = rpe.rot_deg.rmse / authors[k][1];
+    std::printf(
+        "  tum_fr3_teddy200 %-18s RPE %.4f m/s %.3f deg/s (%.3f / %.3f of the authors' "
+        "code), %d lost\n",
+        names[k], rpe.trans.rmse, rpe.rot_deg.rmse, rt, rr, lost[k]);
+    // Measured: A-CVO 0.0955 / 5.943 (0.998 / 1.028); CVO 0.1068 / 6.164 (0.962 / 0.956).
+    EXPECT_EQ(lost[k], 0) << names[k];
+    EXPECT_NEAR(rt, 1.0, 0.05) << names[k];
+    EXPECT_NEAR(rr, 1.0, 0.05) << names[k];
+  }
+}
+
+}  // namespace
+}  // namespace acvo
