@@ -1,8 +1,10 @@
-"""What the measurement scripts share (scripts/bench, scripts/bag_rate, scripts/soak_nodelet).
+"""What the scripts share (scripts/bench, bag_rate, soak_nodelet, and the folder tools
+depth_noise, distort_tum, downsample_tum, register_colour).
 
   paths        the repository, the workspace, the built tools, the shared data sets
   build        scripts/build with its log, the path of a built tool
-  datasets     synthetic sequences rendered once by acvo_synth, the real data sets, names
+  datasets     a folder's associations and depth images, synthetic sequences rendered once by
+               acvo_synth, the real data sets, names
   statistics   percentile and slope (numpy)
   machine      the "machine:" line printed with every figure (nproc, CPU, load, date, commit)
   /proc        memory, CPU time and liveness of a process, the machine's CPU and load
@@ -106,12 +108,44 @@ def write_json(path, data):
 # ------------------------------------------------------------------------------------------
 # Datasets
 # ------------------------------------------------------------------------------------------
+def read_associations(folder):
+    """(rgb stamp, rgb file, depth stamp, depth file) of each line of a folder's associations.txt,
+    colour first whichever way the file lists them: depth first (ICL-NUIM's archives, TUM's
+    associate.py given depth.txt first) is told by the folder the first file lies in, as acvo_tum
+    and tum_to_bag tell it. OSError without the file, ValueError on a line of under 4 fields."""
+    def in_depth(path):
+        return os.path.basename(os.path.dirname(path)).startswith("depth")
+
+    rows = []
+    with open(os.path.join(folder, "associations.txt")) as f:
+        for number, line in enumerate(f, 1):
+            fields = line.split()
+            if not fields or fields[0].startswith("#"):
+                continue
+            if len(fields) < 4:
+                raise ValueError("%s/associations.txt:%d: expected 'stamp file stamp file'"
+                                 % (folder, number))
+            first, second = tuple(fields[0:2]), tuple(fields[2:4])
+            if in_depth(first[1]) and not in_depth(second[1]):
+                first, second = second, first
+            rows.append(first + second)
+    return rows
+
+
+def depth_metres(raw, scale):
+    """A 16-bit depth image in metres (float32), NaN where it holds no reading: 0, or 65535 as
+    7-Scenes marks it (acvo's depthToMeters)."""
+    import numpy as np
+    depth = raw.astype(np.float32) / np.float32(scale)
+    depth[(raw == 0) | (raw == 65535)] = np.nan
+    return depth
+
+
 def count_frames(folder):
     """Frames listed in a folder's associations.txt (0 when absent)."""
     try:
-        with open(os.path.join(folder, "associations.txt")) as f:
-            return sum(1 for line in f if line.strip() and not line.startswith("#"))
-    except OSError:
+        return len(read_associations(folder))
+    except (OSError, ValueError):
         return 0
 
 

@@ -364,6 +364,23 @@ TEST(SynthTool, RegisterColourUndoesAnUnregisteredColourCamera) {
     EXPECT_EQ(readBytes(right / depth), readBytes(u / depth));
   }
   EXPECT_EQ(readRows(right / "groundtruth.txt"), readRows(u / "groundtruth.txt"));
+  // associations.txt depth first, as ICL-NUIM's archives list it: the same colour images.
+  const fs::path depth_first = root / "depth_first_src", from_depth_first = root / "depth_first";
+  fs::copy(u, depth_first, fs::copy_options::recursive);
+  {
+    std::ofstream out(depth_first / "associations.txt");
+    for (const auto& row : readRows(u / "associations.txt")) {
+      ASSERT_EQ(row.size(), 4u);
+      out << row[2] << ' ' << row[3] << ' ' << row[0] << ' ' << row[1] << '\n';
+    }
+  }
+  const std::string script_call = "'" + script.string() + "' '" + depth_first.string() + "' '" +
+                                  from_depth_first.string() + "' --focal-ratio 0.897 --baseline " +
+                                  "0.025 >/dev/null 2>&1";
+  ASSERT_EQ(std::system(script_call.c_str()), 0);
+  for (const std::string image : {"rgb/1000.000000.png", "rgb/1000.033333.png"}) {
+    EXPECT_EQ(readBytes(from_depth_first / image), readBytes(right / image)) << image;
+  }
   EXPECT_NE(registerColour(right, "--focal-ratio 0.897"), 0);  // exists
   EXPECT_NE(registerColour(root / "bad", "--focal-ratio 3"), 0);
   EXPECT_FALSE(fs::exists(root / "bad"));
