@@ -18,6 +18,38 @@ namespace {
 
 using namespace acvo::test;  // the sequences' helpers (sequence_support.hpp)
 
+// Each setting over a TUM folder's frames, from the ground-truth pose nearest its first frame
+// (TUM's motion capture runs at 100 Hz, faster than the camera): each estimate at the frames'
+// colour stamps, and its lost frames.
+struct FolderRun {
+  Trajectory estimate;
+  int lost = 0;
+};
+template <std::size_t N>
+std::array<FolderRun, N> runFolder(const TumDataset& data, const std::array<Params, N>& settings) {
+  const Trajectory& gt = *data.groundtruth();
+  const double t0 = data.frames().front().rgb.stamp;
+  const auto nearest = std::min_element(gt.begin(), gt.end(), [t0](const auto& a, const auto& b) {
+    return std::abs(a.stamp - t0) < std::abs(b.stamp - t0);
+  });
+  std::array<Odometry, N> odo;
+  for (std::size_t k = 0; k < N; ++k) {
+    odo[k] = Odometry(settings[k]);
+    odo[k].reset(nearest->pose);
+  }
+  std::array<FolderRun, N> runs;
+  for (std::size_t i = 0; i < data.size(); ++i) {
+    const Frame frame = data.loadFrame(i);
+    const auto& e = data.frames()[i].rgb;
+    for (std::size_t k = 0; k < N; ++k) {
+      const OdometryResult r = odo[k].process(frame);
+      runs[k].lost += r.tracking == Tracking::kLost;
+      runs[k].estimate.push_back({e.stamp_text, e.stamp, r.pose});
+    }
+  }
+  return runs;
+}
+
 TEST(Sequences, RpeOnRealKinectFrames) {
   const auto shared = test::sharedDataDir();
   if (shared.empty()) GTEST_SKIP() << "../shared/data not present";
@@ -68,52 +100,33 @@ TEST(Sequences, RealHandHeldMotionIsTrackedWithoutLossOrDrift) {
   const TumDataset data((shared / "tum_fr3_teddy200").string());
   ASSERT_TRUE(data.groundtruth());
   const Trajectory& gt = *data.groundtruth();
-  // Start at the ground-truth pose nearest the first frame (motion capture runs at 100 Hz).
-  const double t0 = data.frames().front().rgb.stamp;
-  const auto nearest = std::min_element(gt.begin(), gt.end(), [t0](const auto& a, const auto& b) {
-    return std::abs(a.stamp - t0) < std::abs(b.stamp - t0);
-  });
   // The default (keyframes), the same engine frame to frame, and keyframe clouds twice as dense
   // as the registered ones, on the same frames.
-  std::array<Odometry, 3> odo;
   Params previous_frame;
   previous_frame.odometry.reference = Reference::kPreviousFrame;
-  odo[1] = Odometry(previous_frame);
   Params denser;
   denser.selection.reference_density = 2.0;
-  odo[2] = Odometry(denser);
-  std::array<Trajectory, 3> est;
-  std::array<int, 3> lost = {0, 0, 0};
-  for (int k = 0; k < 3; ++k) odo[k].reset(nearest->pose);
-  for (std::size_t i = 0; i < data.size(); ++i) {
-    const Frame frame = data.loadFrame(i);
-    const auto& e = data.frames()[i].rgb;
-    for (int k = 0; k < 3; ++k) {
-      const OdometryResult r = odo[k].process(frame);
-      lost[k] += r.tracking == Tracking::kLost;
-      est[k].push_back({e.stamp_text, e.stamp, r.pose});
-    }
-  }
-  const RpeResult rpe = computeRpe(gt, est[0]);
-  const double ate = computeAte(gt, est[0]).trans.rmse;
-  const double ate_previous = computeAte(gt, est[1]).trans.rmse;
+  const auto runs = runFolder<3>(data, {Params(), previous_frame, denser});
+  const RpeResult rpe = computeRpe(gt, runs[0].estimate);
+  const double ate = computeAte(gt, runs[0].estimate).trans.rmse;
+  const double ate_previous = computeAte(gt, runs[1].estimate).trans.rmse;
   std::printf(
       "  tum_fr3_teddy200 default RPE %.4f m/s %.3f deg/s, ATE %.4f m (frame to frame "
       "%.4f m), %d lost\n",
-      rpe.trans.rmse, rpe.rot_deg.rmse, ate, ate_previous, lost[0]);
+      rpe.trans.rmse, rpe.rot_deg.rmse, ate, ate_previous, runs[0].lost);
   // Measured 0.0059 m/s, 0.470 deg/s; ATE 0.0061 m against 0.0154 m frame to frame (the kernel
   // alone: 0.0086, 0.579, ATE 0.0105; max_depth 4: 0.0159, 1.066, ATE 0.0185). Bounds 1.3x.
-  EXPECT_EQ(lost[0], 0);
+  EXPECT_EQ(runs[0].lost, 0);
   EXPECT_LT(rpe.trans.rmse, 0.0077);
   EXPECT_LT(rpe.rot_deg.rmse, 0.611);
   // Keyframes against drift: at most 0.7 of the frame-to-frame ATE (the target).
   EXPECT_LT(ate, 0.7 * ate_previous);
   // The denser keyframe clouds (selection.reference_density 2): measured 0.0054 m/s, 0.459
   // deg/s. Bounds 1.1x.
-  const RpeResult dense = computeRpe(gt, est[2]);
+  const RpeResult dense = computeRpe(gt, runs[2].estimate);
   std::printf("  tum_fr3_teddy200 reference_density 2 RPE %.4f m/s %.3f deg/s, %d lost\n",
-              dense.trans.rmse, dense.rot_deg.rmse, lost[2]);
-  EXPECT_EQ(lost[2], 0);
+              dense.trans.rmse, dense.rot_deg.rmse, runs[2].lost);
+  EXPECT_EQ(runs[2].lost, 0);
   EXPECT_LT(dense.trans.rmse, 0.0060);
   EXPECT_LT(dense.rot_deg.rmse, 0.506);
 }
@@ -126,35 +139,18 @@ TEST(Sequences, PaperConfigsReproduceTheAuthorsCodeOnTeddy) {
   if (shared.empty()) GTEST_SKIP() << "../shared/data not present";
   const TumDataset data((shared / "tum_fr3_teddy200").string());
   ASSERT_TRUE(data.groundtruth());
-  const Trajectory& gt = *data.groundtruth();
-  const double t0 = data.frames().front().rgb.stamp;
-  const auto nearest = std::min_element(gt.begin(), gt.end(), [t0](const auto& a, const auto& b) {
-    return std::abs(a.stamp - t0) < std::abs(b.stamp - t0);
-  });
-  std::array<Odometry, 2> odo = {Odometry(paperParams()), Odometry(cvoParams())};
-  std::array<Trajectory, 2> est;
-  std::array<int, 2> lost = {0, 0};
-  for (int k = 0; k < 2; ++k) odo[k].reset(nearest->pose);
-  for (std::size_t i = 0; i < data.size(); ++i) {
-    const Frame frame = data.loadFrame(i);
-    const auto& e = data.frames()[i].rgb;
-    for (int k = 0; k < 2; ++k) {
-      const OdometryResult r = odo[k].process(frame);
-      lost[k] += r.tracking == Tracking::kLost;
-      est[k].push_back({e.stamp_text, e.stamp, r.pose});
-    }
-  }
+  const auto runs = runFolder<2>(data, {paperParams(), cvoParams()});
   const char* names[] = {"paper.yaml (A-CVO)", "cvo.yaml (CVO)"};
   const double authors[2][2] = {{0.0957, 5.78}, {0.111, 6.45}};
   for (int k = 0; k < 2; ++k) {
-    const RpeResult rpe = computeRpe(gt, est[k]);
+    const RpeResult rpe = computeRpe(*data.groundtruth(), runs[k].estimate);
     const double rt = rpe.trans.rmse / authors[k][0], rr = rpe.rot_deg.rmse / authors[k][1];
     std::printf(
         "  tum_fr3_teddy200 %-18s RPE %.4f m/s %.3f deg/s (%.3f / %.3f of the authors' "
         "code), %d lost\n",
-        names[k], rpe.trans.rmse, rpe.rot_deg.rmse, rt, rr, lost[k]);
+        names[k], rpe.trans.rmse, rpe.rot_deg.rmse, rt, rr, runs[k].lost);
     // Measured: A-CVO 0.0955 / 5.943 (0.998 / 1.028); CVO 0.1068 / 6.164 (0.962 / 0.956).
-    EXPECT_EQ(lost[k], 0) << names[k];
+    EXPECT_EQ(runs[k].lost, 0) << names[k];
     EXPECT_NEAR(rt, 1.0, 0.05) << names[k];
     EXPECT_NEAR(rr, 1.0, 0.05) << names[k];
   }
