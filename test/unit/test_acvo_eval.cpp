@@ -178,4 +178,47 @@ TEST(WindowErrors, TurnAndTravelAgainstTheReference) {
   EXPECT_EQ(runCommand(script + "'" + (dir / "elsewhen.txt").string() + "'").status, 2);
 }
 
+// The three-cornered hat of scripts/window_errors: the reference drifts 0.01 m/s along x, one
+// estimate turns 10% less and travels 20% further (0.02 m per window along y), the other drifts
+// 0.03 m/s along z. Their errors are orthogonal over every window, so each pair's differences
+// have a mean square of exactly the sum of the two's, and the split gives each its own.
+TEST(WindowErrors, SplitsTheErrorsAmongTheReferenceAndTheEstimates) {
+  if (std::system("/usr/bin/python3 -c 'import numpy' >/dev/null 2>&1") != 0) {
+    GTEST_SKIP() << "/usr/bin/python3 with numpy is not available";
+  }
+  const fs::path dir = acvo::test::tempDir("window_errors_split");
+  const double kPi = 3.14159265358979323846;
+  auto write = [&](const fs::path& path, double turn, double travel, double drift_x,
+                   double drift_z) {
+    std::ofstream out(path);
+    out.precision(12);
+    for (int i = 0; i <= 60; ++i) {
+      const double t = i / 30.0, half = 0.5 * turn * (20.0 * kPi / 180.0) * t;
+      out << 100.0 + t << " " << drift_x * t << " " << travel * 0.1 * t << " " << drift_z * t
+          << " 0 " << std::sin(half) << " 0 " << std::cos(half) << "\n";
+    }
+  };
+  write(dir / "gt.txt", 1.0, 1.0, 0.01, 0.0);
+  write(dir / "a.txt", 0.9, 1.2, 0.0, 0.0);
+  write(dir / "b.txt", 1.0, 1.0, 0.0, 0.03);
+  const std::string script = "'" + (acvo::test::sourceDir() / "scripts/window_errors").string() +
+                             "' '" + (dir / "gt.txt").string() + "' ";
+  const ToolRun run = runCommand(script + "'" + (dir / "a.txt").string() + "' '" +
+                                 (dir / "b.txt").string() + "'");
+  ASSERT_EQ(run.status, 0) << run.output;
+  EXPECT_NE(run.output.find("the reference: rotation 0.0000 deg, translation 0.0100 m"),
+            std::string::npos)
+      << run.output;
+  EXPECT_NE(run.output.find("a.txt: rotation 2.0000 deg, translation 0.0200 m"),
+            std::string::npos)
+      << run.output;
+  EXPECT_NE(run.output.find("b.txt: rotation 0.0000 deg, translation 0.0300 m"),
+            std::string::npos)
+      << run.output;
+  // One estimate alone gives no split: two sources cannot be told apart.
+  const ToolRun one = runCommand(script + "'" + (dir / "a.txt").string() + "'");
+  ASSERT_EQ(one.status, 0) << one.output;
+  EXPECT_EQ(one.output.find("three-cornered hat"), std::string::npos) << one.output;
+}
+
 }  // namespace
