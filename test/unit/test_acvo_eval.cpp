@@ -203,17 +203,15 @@ TEST(WindowErrors, SplitsTheErrorsAmongTheReferenceAndTheEstimates) {
   write(dir / "b.txt", 1.0, 1.0, 0.0, 0.03);
   const std::string script = "'" + (acvo::test::sourceDir() / "scripts/window_errors").string() +
                              "' '" + (dir / "gt.txt").string() + "' ";
-  const ToolRun run = runCommand(script + "'" + (dir / "a.txt").string() + "' '" +
-                                 (dir / "b.txt").string() + "'");
+  const ToolRun run =
+      runCommand(script + "'" + (dir / "a.txt").string() + "' '" + (dir / "b.txt").string() + "'");
   ASSERT_EQ(run.status, 0) << run.output;
   EXPECT_NE(run.output.find("the reference: rotation 0.0000 deg, translation 0.0100 m"),
             std::string::npos)
       << run.output;
-  EXPECT_NE(run.output.find("a.txt: rotation 2.0000 deg, translation 0.0200 m"),
-            std::string::npos)
+  EXPECT_NE(run.output.find("a.txt: rotation 2.0000 deg, translation 0.0200 m"), std::string::npos)
       << run.output;
-  EXPECT_NE(run.output.find("b.txt: rotation 0.0000 deg, translation 0.0300 m"),
-            std::string::npos)
+  EXPECT_NE(run.output.find("b.txt: rotation 0.0000 deg, translation 0.0300 m"), std::string::npos)
       << run.output;
   // One estimate alone gives no split: two sources cannot be told apart.
   const ToolRun one = runCommand(script + "'" + (dir / "a.txt").string() + "'");
