@@ -585,6 +585,24 @@ void Odometry::keepSecondStart(Registration& reg, OdometryResult& r, SolverResul
   reg.solver = std::move(again);
 }
 
+bool Odometry::turnStart(const Tracked& reference, const Eigen::Isometry3d& guess,
+                         Registration& reg, OdometryResult& r) {
+  Eigen::Isometry3d start = reg.solver.transform;
+  start.translation() = guess.translation();
+  r.second_start = true;
+  SolverResult again;
+  arena_->arena.execute(
+      [&] { again = engine_->align(*reference.cloud, *reg.moving, start, AlignStages::kFinest); });
+  addStartCost(reg.solver, again);
+  if (failed(again.status) || !(again.objective > kSecondStartMargin * reg.solver.objective)) {
+    return false;
+  }
+  keepSecondStart(reg, r, std::move(again));
+  // Kept for the image's ambiguity, not for a pull: no memory of it (kSecondStartMemory).
+  reg.second_start_kept = false;
+  return true;
+}
+
 void Odometry::secondStart(const Tracked& reference, const Eigen::Isometry3d& guess,
                            Registration& reg, OdometryResult& r, double stamp) {
   if (failed(reg.solver.status)) return;
@@ -597,6 +615,10 @@ void Odometry::secondStart(const Tracked& reference, const Eigen::Isometry3d& gu
   const double scale = std::max(1.0, frames * frames);
   const bool jerk =
       miss_m > scale * kSecondStartTranslation || miss_deg > scale * kSecondStartRotation;
+  if (miss_m > scale * kSecondStartTranslation && miss_deg > scale * kSecondStartRotation &&
+      turnStart(reference, guess, reg, r)) {
+    return;
+  }
   if (!jerk) {
     // The guess's usual miss, where the guess is a constant-velocity prediction: the camera's
     // velocity changes between the last tracked frames (their running second moment; twists,
