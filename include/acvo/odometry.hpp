@@ -123,15 +123,6 @@ inline constexpr double kSecondStartMargin = 1.2;
 // memory apart (under 4 Hz) keep the plain margin.
 inline constexpr double kSecondStartKeptMargin = 2.0;
 inline constexpr double kSecondStartMemory = 0.25;  // s
-// A turn that misses the guess by more than kSecondStartRotation, registered with a translation
-// that misses it by more than kSecondStartTranslation too, may be the turn's own image motion
-// taken partly as a sideways move: a small turn and a sideways move shift the image alike, and
-// the coarse levels' few points cannot tell them apart. The finest level is then run again from
-// the turn registered with the guess's translation, and kept where its kernel value is
-// kSecondStartMargin times the first's (docs/accuracy.md, twenty-sixth round: a camera turning
-// at 112 deg/s whose turn jumped from 0.7 to 5.3 deg a frame, registered 91 mm off, is kept to
-// 0.02 mm at 4.4x the first's kernel value). What misled the first is no pull from something in
-// view: kSecondStartMemory does not start.
 // Under those limits a registration whose motion misses the guess by more than
 // kSecondStartCheckSigmas times the guess's usual miss (the root mean square of the camera's
 // recent velocity changes over the interval, VelocityFilter::changeMoment), and by at least
@@ -155,6 +146,16 @@ inline constexpr double kSecondStartCheckTranslation = 0.005;  // m
 inline constexpr double kSecondStartCheckRotation = 0.75;      // deg
 inline constexpr double kSecondStartCheckSigmas = 3.0;
 inline constexpr double kSecondStartCheckMargin = 1.1;
+// A turn that misses the guess by more than kSecondStartRotation, registered with a translation
+// that misses it by more than kSecondStartTranslation too, may be the turn's own image motion
+// taken partly as a sideways move: a small turn and a sideways move shift the image alike, and
+// the coarse levels' few points cannot tell them apart. The finest level is then run again from
+// the turn registered with the guess's translation, and kept where its kernel value is
+// kSecondStartMargin times the first's (docs/accuracy.md, twenty-sixth round: a camera turning
+// at 112 deg/s whose turn jumped from 0.7 to 5.3 deg a frame, registered 91 mm off, is kept to
+// 0.02 mm at 4.4x the first's kernel value). What misled the first is no pull from something in
+// view: kSecondStartMemory does not start (Odometry::turnStart).
+
 // Where no velocity is known yet (the first registered frame, or the first after a lost one),
 // the guess cannot hold the registration to the camera's motion, and something large moving in
 // view can take it along from the start (a person crossing 1.2 m in front of a camera at
