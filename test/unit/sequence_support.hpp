@@ -124,4 +124,24 @@ inline std::pair<double, double> trueMotion(const Trajectory& gt, int a, int b) 
   return {m.translation().norm(), Eigen::AngleAxisd(m.rotation()).angle() * 180.0 / M_PI};
 }
 
+// Frames [first, end) of a rendered sequence with the default settings and with one start
+// (OdometryParams::second_start off), each printed; neither may lose a frame.
+inline std::array<PolicyRun, 2> withAndWithoutSecondStart(const synth::SynthSequence& seq,
+                                                          int first, int end) {
+  const Trajectory all = groundtruthOf(seq);
+  const Trajectory gt(all.begin() + first, all.begin() + end);
+  Params one_start;
+  one_start.odometry.second_start = false;
+  auto runs = runPolicies<2>(
+      {Params(), one_start}, int(gt.size()), [&](int i) { return seq.frame(first + i).toFrame(); },
+      gt);
+  for (int p = 0; p < 2; ++p) {
+    std::printf("  %s: RPE %.5f m/s %.4f deg/s, %d lost, %d second starts (%d kept)\n",
+                p == 0 ? "default" : "one start", runs[p].rpe.trans.rmse, runs[p].rpe.rot_deg.rmse,
+                runs[p].lost, runs[p].second_starts, runs[p].second_starts_kept);
+    EXPECT_EQ(runs[p].lost, 0);
+  }
+  return runs;
+}
+
 }  // namespace acvo::test

@@ -33,26 +33,6 @@ TEST(Sequences, APersonCrossingTheViewIsNotMistakenForTheCamerasMotion) {
                       {0.00028, 0.0106}, 50.0);
 }
 
-// Frames [first, end) of a rendered sequence with the default settings and with one start
-// (OdometryParams::second_start off), each printed; neither may lose a frame.
-std::array<PolicyRun, 2> withAndWithoutSecondStart(const synth::SynthSequence& seq, int first,
-                                                   int end) {
-  const Trajectory all = groundtruthOf(seq);
-  const Trajectory gt(all.begin() + first, all.begin() + end);
-  Params one_start;
-  one_start.odometry.second_start = false;
-  auto runs = runPolicies<2>(
-      {Params(), one_start}, int(gt.size()), [&](int i) { return seq.frame(first + i).toFrame(); },
-      gt);
-  for (int p = 0; p < 2; ++p) {
-    std::printf("  %s: RPE %.5f m/s %.4f deg/s, %d lost, %d second starts (%d kept)\n",
-                p == 0 ? "default" : "one start", runs[p].rpe.trans.rmse, runs[p].rpe.rot_deg.rmse,
-                runs[p].lost, runs[p].second_starts, runs[p].second_starts_kept);
-    EXPECT_EQ(runs[p].lost, 0);
-  }
-  return runs;
-}
-
 // A person walking at half the pace (acvo_synth --walker 0.5, seed 62: "w62"), over w62's 300
 // frames (the camera's path depends on the sequence's length).
 synth::SynthSequence slowWalker() {

@@ -613,12 +613,10 @@ void Odometry::secondStart(const Tracked& reference, const Eigen::Isometry3d& gu
   // A velocity change misses by its acceleration times the interval squared.
   const double frames = r.interval / kSecondStartInterval;
   const double scale = std::max(1.0, frames * frames);
-  const bool jerk =
-      miss_m > scale * kSecondStartTranslation || miss_deg > scale * kSecondStartRotation;
-  if (miss_m > scale * kSecondStartTranslation && miss_deg > scale * kSecondStartRotation &&
-      turnStart(reference, guess, reg, r)) {
-    return;
-  }
+  const bool moved_off = miss_m > scale * kSecondStartTranslation;
+  const bool turned_off = miss_deg > scale * kSecondStartRotation;
+  const bool jerk = moved_off || turned_off;
+  if (moved_off && turned_off && turnStart(reference, guess, reg, r)) return;
   if (!jerk) {
     // The guess's usual miss, where the guess is a constant-velocity prediction: the camera's
     // velocity changes between the last tracked frames (their running second moment; twists,
