@@ -146,16 +146,6 @@ inline constexpr double kSecondStartCheckTranslation = 0.005;  // m
 inline constexpr double kSecondStartCheckRotation = 0.75;      // deg
 inline constexpr double kSecondStartCheckSigmas = 3.0;
 inline constexpr double kSecondStartCheckMargin = 1.1;
-// A turn that misses the guess by more than kSecondStartRotation, registered with a translation
-// that misses it by more than kSecondStartTranslation too, may be the turn's own image motion
-// taken partly as a sideways move: a small turn and a sideways move shift the image alike, and
-// the coarse levels' few points cannot tell them apart. The finest level is then run again from
-// the turn registered with the guess's translation, and kept where its kernel value is
-// kSecondStartMargin times the first's (docs/accuracy.md, twenty-sixth round: a camera turning
-// at 112 deg/s whose turn jumped from 0.7 to 5.3 deg a frame, registered 91 mm off, is kept to
-// 0.02 mm at 4.4x the first's kernel value). What misled the first is no pull from something in
-// view: kSecondStartMemory does not start (Odometry::turnStart).
-
 // Where no velocity is known yet (the first registered frame, or the first after a lost one),
 // the guess cannot hold the registration to the camera's motion, and something large moving in
 // view can take it along from the start (a person crossing 1.2 m in front of a camera at
@@ -233,9 +223,7 @@ bool replacesReference(const SolverResult& s, std::size_t points, std::size_t re
 //    (kSecondStartKeptMargin within kSecondStartMemory of a kept one;
 //    OdometryParams::second_start); one that misses it by less, but unusually for the camera
 //    (kSecondStartCheckSigmas), is run again too and kept only where the second start scores
-//    kSecondStartCheckMargin times higher. One whose turn and translation both miss it by more
-//    than the limits is first run again from its turn with the prior's translation
-//    (turnStart). Where no velocity is known yet, a registration that
+//    kSecondStartCheckMargin times higher. Where no velocity is known yet, a registration that
 //    leaves many points unexplained is run again from those points (kRestFraction, kRestMargin).
 class Odometry {
  public:
@@ -343,11 +331,6 @@ class Odometry {
   // where it scores kSecondStartCheckMargin times higher than the first.
   void secondStart(const Tracked& reference, const Eigen::Isometry3d& guess, Registration& reg,
                    OdometryResult& r, double stamp);
-  // Where reg's turn and translation both missed `guess` by more than the second start's limits
-  // (as scaled by secondStart), the finest level again from reg's turn with the guess's
-  // translation; returns whether it was kept (kSecondStartMargin times the first's kernel value).
-  bool turnStart(const Tracked& reference, const Eigen::Isometry3d& guess, Registration& reg,
-                 OdometryResult& r);
   // Whether registrations of this frame move its depth again (sync_depth, a delay, a staged
   // engine).
   bool retimes(const OdometryResult& r) const;

@@ -585,24 +585,6 @@ void Odometry::keepSecondStart(Registration& reg, OdometryResult& r, SolverResul
   reg.solver = std::move(again);
 }
 
-bool Odometry::turnStart(const Tracked& reference, const Eigen::Isometry3d& guess,
-                         Registration& reg, OdometryResult& r) {
-  Eigen::Isometry3d start = reg.solver.transform;
-  start.translation() = guess.translation();
-  r.second_start = true;
-  SolverResult again;
-  arena_->arena.execute(
-      [&] { again = engine_->align(*reference.cloud, *reg.moving, start, AlignStages::kFinest); });
-  addStartCost(reg.solver, again);
-  if (failed(again.status) || !(again.objective > kSecondStartMargin * reg.solver.objective)) {
-    return false;
-  }
-  keepSecondStart(reg, r, std::move(again));
-  // Kept for the image's ambiguity, not for a pull: no memory of it (kSecondStartMemory).
-  reg.second_start_kept = false;
-  return true;
-}
-
 void Odometry::secondStart(const Tracked& reference, const Eigen::Isometry3d& guess,
                            Registration& reg, OdometryResult& r, double stamp) {
   if (failed(reg.solver.status)) return;
@@ -613,10 +595,8 @@ void Odometry::secondStart(const Tracked& reference, const Eigen::Isometry3d& gu
   // A velocity change misses by its acceleration times the interval squared.
   const double frames = r.interval / kSecondStartInterval;
   const double scale = std::max(1.0, frames * frames);
-  const bool moved_off = miss_m > scale * kSecondStartTranslation;
-  const bool turned_off = miss_deg > scale * kSecondStartRotation;
-  const bool jerk = moved_off || turned_off;
-  if (moved_off && turned_off && turnStart(reference, guess, reg, r)) return;
+  const bool jerk =
+      miss_m > scale * kSecondStartTranslation || miss_deg > scale * kSecondStartRotation;
   if (!jerk) {
     // The guess's usual miss, where the guess is a constant-velocity prediction: the camera's
     // velocity changes between the last tracked frames (their running second moment; twists,
