@@ -212,6 +212,7 @@ void Odometry::reset(const Eigen::Isometry3d& pose, const Matrix6d& covariance) 
   last_.reset();
   lost_in_a_row_ = 0;
   second_start_kept_at_.reset();
+  last_objective_.reset();
 }
 
 std::optional<double> Odometry::lastTrackedStamp() const {
@@ -420,6 +421,7 @@ OdometryResult Odometry::track(const Frame& frame,
   if (reg.judgement.tracking == Tracking::kLost) {
     lost(r, reg, reg.moving, frame.stamp);
     second_start_kept_at_.reset();
+    last_objective_.reset();
   } else {
     tracked(r, reg, reg.moving);
     if (reg.second_start_kept) second_start_kept_at_ = frame.stamp;
@@ -585,6 +587,24 @@ void Odometry::keepSecondStart(Registration& reg, OdometryResult& r, SolverResul
   reg.solver = std::move(again);
 }
 
+bool Odometry::turnStart(const Tracked& reference, const Eigen::Isometry3d& guess,
+                         Registration& reg, OdometryResult& r) {
+  Eigen::Isometry3d start = reg.solver.transform;
+  start.translation() = guess.translation();
+  r.second_start = true;
+  SolverResult again;
+  arena_->arena.execute(
+      [&] { again = engine_->align(*reference.cloud, *reg.moving, start, AlignStages::kFinest); });
+  addStartCost(reg.solver, again);
+  if (failed(again.status) || !(again.objective > kSecondStartMargin * reg.solver.objective)) {
+    return false;
+  }
+  keepSecondStart(reg, r, std::move(again));
+  // Kept for the image's ambiguity, not for a pull: no memory of it (kSecondStartMemory).
+  reg.second_start_kept = false;
+  return true;
+}
+
 void Odometry::secondStart(const Tracked& reference, const Eigen::Isometry3d& guess,
                            Registration& reg, OdometryResult& r, double stamp) {
   if (failed(reg.solver.status)) return;
@@ -595,8 +615,13 @@ void Odometry::secondStart(const Tracked& reference, const Eigen::Isometry3d& gu
   // A velocity change misses by its acceleration times the interval squared.
   const double frames = r.interval / kSecondStartInterval;
   const double scale = std::max(1.0, frames * frames);
-  const bool jerk =
-      miss_m > scale * kSecondStartTranslation || miss_deg > scale * kSecondStartRotation;
+  const bool moved_off = miss_m > scale * kSecondStartTranslation;
+  const bool turned_off = miss_deg > scale * kSecondStartRotation;
+  const bool jerk = moved_off || turned_off;
+  // A low kernel value against the last frame's says the first start ended in a wrong maximum.
+  const bool scored_low =
+      last_objective_ && reg.solver.objective < kTurnStartScoreShare * *last_objective_;
+  if (moved_off && turned_off && scored_low && turnStart(reference, guess, reg, r)) return;
   if (!jerk) {
     // The guess's usual miss, where the guess is a constant-velocity prediction: the camera's
     // velocity changes between the last tracked frames (their running second moment; twists,
@@ -692,6 +717,7 @@ void Odometry::tracked(OdometryResult& r, const Registration& reg,
   velocity_ = r.motion;
   velocity_interval_ = r.interval;
   motion_known_ = true;
+  last_objective_ = reg.solver.objective;
   lost_in_a_row_ = 0;
 
   Tracked frame{current, r.frame_index, pose_, pose_covariance_, to_keyframe, reg.covariance};
