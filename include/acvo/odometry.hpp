@@ -242,10 +242,10 @@ bool replacesReference(const SolverResult& s, std::size_t points, std::size_t re
 //    OdometryParams::second_start); one that misses it by less, but unusually for the camera
 //    (kSecondStartCheckSigmas), is run again too and kept only where the second start scores
 //    kSecondStartCheckMargin times higher. One whose turn and translation both miss it by more
-//    than the limits, and whose kernel value is under 0.3 of the last frame's, is first run again
-//    from its turn with the prior's translation (turnStart). Where no velocity is known yet, a
-//    registration that leaves many points unexplained is run again from those points
-//    (kRestFraction, kRestMargin).
+//    than the limits, and whose kernel value is under kTurnStartScoreShare times the last
+//    frame's, is first run again from its turn with the prior's translation (turnStart). Where no
+//    velocity is known yet, a registration that leaves many points unexplained is run again from
+//    those points (kRestFraction, kRestMargin).
 class Odometry {
  public:
   explicit Odometry(const Params& params = Params());
