@@ -345,6 +345,10 @@ class Odometry {
                  OdometryResult& r);
   // A second start replaces the first: `again`, with the cost of both (addStartCost).
   void keepSecondStart(Registration& reg, OdometryResult& r, SolverResult again);
+  // The finest level of reg's frame against `reference` from `start`, as a second start (marked
+  // in r, its cost added to reg's: addStartCost); secondStart and turnStart judge the result.
+  SolverResult finestFrom(const Tracked& reference, Registration& reg,
+                          const Eigen::Isometry3d& start, OdometryResult& r);
   // Where reg's motion missed `guess` (OdometryParams::second_start, kSecondStartTranslation),
   // the finest level again from the guess, kept unless the first scores kSecondStartMargin
   // times higher (kSecondStartKeptMargin within kSecondStartMemory of the last one kept; `stamp`

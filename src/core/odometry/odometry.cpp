@@ -587,15 +587,21 @@ void Odometry::keepSecondStart(Registration& reg, OdometryResult& r, SolverResul
   reg.solver = std::move(again);
 }
 
-bool Odometry::turnStart(const Tracked& reference, const Eigen::Isometry3d& guess,
-                         Registration& reg, OdometryResult& r) {
-  Eigen::Isometry3d start = reg.solver.transform;
-  start.translation() = guess.translation();
+SolverResult Odometry::finestFrom(const Tracked& reference, Registration& reg,
+                                  const Eigen::Isometry3d& start, OdometryResult& r) {
   r.second_start = true;
   SolverResult again;
   arena_->arena.execute(
       [&] { again = engine_->align(*reference.cloud, *reg.moving, start, AlignStages::kFinest); });
   addStartCost(reg.solver, again);
+  return again;
+}
+
+bool Odometry::turnStart(const Tracked& reference, const Eigen::Isometry3d& guess,
+                         Registration& reg, OdometryResult& r) {
+  Eigen::Isometry3d start = reg.solver.transform;
+  start.translation() = guess.translation();
+  SolverResult again = finestFrom(reference, reg, start, r);
   if (failed(again.status) || !(again.objective > kSecondStartMargin * reg.solver.objective)) {
     return false;
   }
@@ -639,11 +645,7 @@ void Odometry::secondStart(const Tracked& reference, const Eigen::Isometry3d& gu
         std::max(scale * kSecondStartCheckRotation, kSecondStartCheckSigmas * usual_deg);
     if (miss_m <= check_m && miss_deg <= check_deg) return;
   }
-  r.second_start = true;
-  SolverResult again;
-  arena_->arena.execute(
-      [&] { again = engine_->align(*reference.cloud, *reg.moving, guess, AlignStages::kFinest); });
-  addStartCost(reg.solver, again);
+  SolverResult again = finestFrom(reference, reg, guess, r);
   if (failed(again.status)) return;
   const bool pulled_lately = second_start_kept_at_ && stamp >= *second_start_kept_at_ &&
                              stamp - *second_start_kept_at_ <= kSecondStartMemory;
