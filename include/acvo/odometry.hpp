@@ -308,7 +308,7 @@ class Odometry {
   // The frame with its colour resampled to the depth camera (colour_ratio_ set).
   Frame resampled(const Frame& frame) const;
   // The colour resampling for the check's verdict (resample_unregistered_colour), and the
-  // engine without the photometric term while it lasts.
+  // engine without the photometric term, led by the depth, while it lasts.
   void actOnColourVerdict();
   // The steps of track(), in order.
   // The camera's motion over `seconds`, as the last frame-to-frame motion says; none until two

@@ -80,6 +80,15 @@ struct CoarseToFineParams {
   // depth is exact, and only on depth taken at the colour's instant (Frame::depth_stamp:
   // a delay moves the depth by an estimated motion, whose error it would follow).
   bool dense_point_to_plane = true;
+  // The last level led by the depth: both point-to-plane terms at the weight their own learned
+  // scales give (no fade by depth_noise, the dense term whatever its independence) and the
+  // kernel's quadratic at kDepthLedKernelShare of its weight. The kernel's optimum is pulled
+  // towards no motion on real Kinect depth (7-Scenes: the chain of registrations turned 0.935
+  // of the reference's turn), the plane residuals measured in the reference's image are not;
+  // where the colour's residuals stand beside the kernel they correct the pull, where the colour
+  // is from another camera they cannot. The odometry turns it on, with photometric off, where
+  // it resamples such colour (docs/accuracy.md, twenty-ninth round).
+  bool depth_led = false;
   // The photometric term measures each frame's brightness against the reference's (the median
   // ratio of their grey values at the points it compares) and compares grey values at that
   // gain: a camera's auto exposure changes the brightness from frame to frame. Off: the grey
@@ -260,6 +269,7 @@ void visitParams(Params_& p, Visitor&& visit) {
   visit("coarse_to_fine", "photometric", c.photometric);
   visit("coarse_to_fine", "point_to_plane", c.point_to_plane);
   visit("coarse_to_fine", "dense_point_to_plane", c.dense_point_to_plane);
+  visit("coarse_to_fine", "depth_led", c.depth_led);
   visit("coarse_to_fine", "photometric_gain", c.photometric_gain);
   visit("coarse_to_fine", "photometric_vignetting", c.photometric_vignetting);
   visit("coarse_to_fine", "exposure_time", c.exposure_time);

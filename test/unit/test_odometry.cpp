@@ -566,6 +566,34 @@ TEST(Odometry, ColourResampledByTheCameraFoundWhenAsked) {
   EXPECT_TRUE(checked);
 }
 
+// Once the colour is resampled, the last level is led by the depth (CoarseToFineParams::
+// depth_led): the dense plane term, off on noise in blobs as a real Kinect's, then counts fully.
+// A registered camera with the same noise keeps it off.
+TEST(Odometry, ColourFromASecondCameraLeavesTheLastLevelToTheDepth) {
+  synth::SequenceOptions o;
+  o.frames = 13;
+  o.colour_focal_ratio = 0.897;
+  o.depth_noise_correlation = 3.0;
+  for (const bool unregistered : {true, false}) {
+    SCOPED_TRACE(unregistered ? "colour from a second camera" : "registered colour");
+    if (!unregistered) o.colour_focal_ratio = 1.0;
+    const synth::SynthSequence seq(o);
+    Odometry odo;
+    odo.reset(seq.poses()[0]);
+    bool resampled = false;
+    for (int i = 0; i < seq.size(); ++i) {
+      const OdometryResult r = odo.process(seq.frame(i).toFrame());
+      resampled = resampled || r.colour_resampled;
+      if (i == 0) continue;  // the first frame registers nothing
+      ASSERT_EQ(r.tracking, Tracking::kOk) << i;
+      EXPECT_EQ(r.solver.dense_weight, r.colour_resampled ? 1.0 : 0.0) << i;
+    }
+    EXPECT_EQ(resampled, unregistered);
+    EXPECT_EQ(odo.describeColour().find("led by the depth") != std::string::npos, unregistered)
+        << odo.describeColour();
+  }
+}
+
 TEST(Odometry, DeterministicForTheSameFramesWhateverTheThreadCount) {
   const auto seq = exactSequence(4);
   Eigen::Isometry3d last[2];

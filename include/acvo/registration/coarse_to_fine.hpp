@@ -27,6 +27,14 @@ struct CoarseToFineCloud : PreparedCloud {
 // Whether the last level adds direct terms to the kernel's.
 bool directTerms(const CoarseToFineParams& p);
 
+// The depth noise the plane terms' weights fade against (pointToPlaneSums, denseGrid): the
+// kernel's depth_noise, or 0 (no fade: each term at its learned scale's weight) when the last
+// level is led by the depth (CoarseToFineParams::depth_led), where the kernel's quadratic
+// counts kDepthLedKernelShare of its weight. 0.3 of 0.5, 0.3, 0.1 and 0 on kitchen7s_dev and
+// eight rendered rooms of colour from another camera (docs/accuracy.md, twenty-ninth round).
+double planeFadeNoise(const CoarseToFineParams& p);
+constexpr double kDepthLedKernelShare = 0.3;
+
 // The length-scales of the levels: ell_init, ell_init * ell_reduction, ... down to ell_min
 // (always the last).
 std::vector<double> levelElls(const CoarseToFineParams& p);

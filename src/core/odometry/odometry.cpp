@@ -356,10 +356,16 @@ void Odometry::actOnColourVerdict() {
   // Resampled by the focal ratio, a point's colour is still off by the cameras' baseline (a few
   // pixels), and by the baseline found too, by that estimate's error (about 5 mm, a pixel or two
   // at 2 m): near enough for the labels and the selection, too far for grey values compared at
-  // a sub-pixel (docs/accuracy.md, fourteenth and fifteenth rounds). The keyframe's prepared
-  // cloud serves either engine.
+  // a sub-pixel (docs/accuracy.md, fourteenth and fifteenth rounds). Without the grey values,
+  // nothing corrects the kernel's pull towards no motion on real depth: the last level is led
+  // by the depth's plane terms (CoarseToFineParams::depth_led; twenty-ninth round). A keyframe
+  // prepared by the other engine serves either (the dense term waits for a keyframe with a depth
+  // grid); the verdict's frame is rebuilt as the keyframe by the new one (checkColour).
   Params engine_params = params_;
-  if (colour_ratio_) engine_params.coarse_to_fine.photometric = false;
+  if (colour_ratio_) {
+    engine_params.coarse_to_fine.photometric = false;
+    engine_params.coarse_to_fine.depth_led = true;
+  }
   engine_ = makeRegistrationEngine(engine_params);
 }
 
@@ -373,10 +379,11 @@ std::string Odometry::describeColour() const {
   if (colour_ratio_) {
     text += params_.odometry.resample_colour_baseline
                 ? ". Meanwhile each frame's colour is resampled to the depth camera by that "
-                  "camera, and registered without the photometric term "
+                  "camera, and registered without the photometric term, led by the depth "
                   "(odometry/resample_unregistered_colour, resample_colour_baseline)"
                 : ". Meanwhile each frame's colour is resampled by that ratio, and registered "
-                  "without the photometric term (odometry/resample_unregistered_colour)";
+                  "without the photometric term, led by the depth "
+                  "(odometry/resample_unregistered_colour)";
   }
   return text;
 }

@@ -49,8 +49,9 @@ double addDirectTerms(const LevelSums& s, double ell, const LevelDirect& direct,
   const double mass = s.F / double(std::max<std::int64_t>(s.matched, 1));
   const double to_units = mass > 0.0 ? 1.0 / (ell * ell * mass) : 0.0;
   if (!(to_units > 0.0)) return 0.0;
-  H = s.H * to_units;
-  g = s.g * to_units;
+  const double share = p.depth_led ? kDepthLedKernelShare : 1.0;
+  H = s.H * (to_units * share);
+  g = s.g * (to_units * share);
   const std::vector<Landing> landed =
       landings(*direct.reference, *direct.moving, *direct.moving_cloud, T);
   if (p.photometric) {
@@ -62,7 +63,7 @@ double addDirectTerms(const LevelSums& s, double ell, const LevelDirect& direct,
     g += d.g;
   }
   if (p.point_to_plane) {
-    const DirectSums d = pointToPlaneSums(*direct.reference, landed, p.depth_noise);
+    const DirectSums d = pointToPlaneSums(*direct.reference, landed, planeFadeNoise(p));
     H += d.H;
     g += d.g;
   }
@@ -112,6 +113,8 @@ bool iterateLevel(LevelKernel& kernel, const LevelDirect& direct, double ell, do
 
 }  // namespace
 
+double planeFadeNoise(const CoarseToFineParams& p) { return p.depth_led ? 0.0 : p.depth_noise; }
+
 bool directTerms(const CoarseToFineParams& p) {
   return p.photometric || p.point_to_plane || p.dense_point_to_plane;
 }
@@ -140,7 +143,7 @@ std::shared_ptr<CoarseToFineCloud> prepareCoarseToFine(LabelledCloud cloud,
   auto out = std::make_shared<CoarseToFineCloud>();
   out->cloud = std::move(cloud);
   if (directTerms(p)) {
-    out->images = directImages(out->cloud, p.dense_point_to_plane, p.depth_noise);
+    out->images = directImages(out->cloud, p.dense_point_to_plane, planeFadeNoise(p));
   }
   out->ms_prepare = msSince(t0);
   if (as_reference) prepareCoarseToFineReference(*out, p);
