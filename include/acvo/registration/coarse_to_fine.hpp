@@ -30,8 +30,9 @@ bool directTerms(const CoarseToFineParams& p);
 // The depth noise the plane terms' weights fade against (pointToPlaneSums, denseGrid): the
 // kernel's depth_noise, or 0 (no fade: each term at its learned scale's weight) when the last
 // level is led by the depth (CoarseToFineParams::depth_led), where the kernel's quadratic
-// counts kDepthLedKernelShare of its weight. 0.3 of 0.5, 0.3, 0.1 and 0 on kitchen7s_dev and
-// eight rendered rooms of colour from another camera (docs/accuracy.md, twenty-ninth round).
+// counts kDepthLedKernelShare of its weight: the best of 1, 0.5, 0.3, 0.1 and 0 on kitchen7s_dev
+// and on eight rendered rooms of colour from another camera together (docs/accuracy.md,
+// twenty-ninth round).
 double planeFadeNoise(const CoarseToFineParams& p);
 constexpr double kDepthLedKernelShare = 0.3;
 
