@@ -50,6 +50,11 @@ conversion, hole marking, pyramids and registration).
 way to see how wide each method's basin is (the dataset is then named <folder>_everyK).
 --camera gives every method other intrinsics than the folder's camera.yaml: a calibration of
 one's own, or a focal length a few percent off to see how much each method depends on it.
+--offset auto evaluates each dataset at the offset between the reference's clock and the
+frames' stamps at which every row's frame-to-frame turns agree best with the reference's
+(found from all rows together, so that no method is favoured), printed below the table; a
+camera's stamps that lag its exposures by some milliseconds charge every method with the
+reference's motion over that lag, and a precise method the most in proportion.
 )";
 
 constexpr const char* kFooter = "Exit status: 0 success, 2 bad arguments or input.";
@@ -62,6 +67,7 @@ struct Options {
   long frames = -1, stride = 1;
   int repeat = 1;
   bool peer_guess = false;
+  std::optional<double> offset = 0.0;  // empty: estimated per dataset (--offset auto)
 };
 
 // The command line into `o`; nullopt to go on, else the exit status.
@@ -118,6 +124,9 @@ std::optional<int> parseOptions(CLI::App& app, Options& o, int argc, char** argv
       ->type_name("K")
       ->capture_default_str()
       ->check(acvo::tools::numberIn(1L, 1000000L, "within [1, 1000000]"));
+  acvo::tools::addOffsetOption(app, o.offset,
+                               "added to the frames' stamps where they are looked up in the "
+                               "reference (a clock offset; auto: found per dataset)");
   app.add_option("--json", o.json, "write every figure as JSON")->type_name("FILE");
   app.add_option("--trajectories", o.trajectories,
                  "write each estimate as DIR/<dataset>-<method>[-<setting>].txt")
@@ -136,6 +145,9 @@ struct Row {
   bool best = false;  // a <peer>_best row
   acvo::Trajectory trajectory;
   long lost = 0;
+  double offset = 0.0;  // s, added to the stamps against the reference's
+  bool offset_found = false;    // by --offset auto
+  std::string offset_refused;   // why --offset auto found none (then offset 0)
   double rpe_trans = NAN, rpe_rot = NAN, ate = NAN;
   // Per run: the median and 90th percentile over frames of the wall and CPU times (ms), and
   // the median as a ratio of the best RgbdOdometry row's median in that run.
@@ -293,13 +305,16 @@ void runOnce(std::vector<Entry>& entries, const std::vector<acvo::Frame>& frames
   }
 }
 
-void evaluate(Row& row, const acvo::TumDataset& data) {
+void evaluate(Row& row, const acvo::TumDataset& data, double offset) {
+  row.offset = offset;
   if (!data.groundtruth()) return;
   try {
-    const acvo::RpeResult rpe = acvo::computeRpe(*data.groundtruth(), row.trajectory);
+    const acvo::Trajectory& gt = *data.groundtruth();
+    const acvo::RpeResult rpe =
+        acvo::computeRpe(gt, row.trajectory, 1.0, acvo::DeltaUnit::kSeconds, offset);
     row.rpe_trans = rpe.trans.rmse;
     row.rpe_rot = rpe.rot_deg.rmse;
-    row.ate = acvo::computeAte(*data.groundtruth(), row.trajectory).trans.rmse;
+    row.ate = acvo::computeAte(gt, row.trajectory, 0.02, offset).trans.rmse;
   } catch (const std::exception& e) {
     std::cerr << "acvo_compare: " << row.dataset << " " << row.method << " " << row.setting
               << ": no evaluation: " << e.what() << "\n";
@@ -337,6 +352,12 @@ std::map<std::string, std::size_t> bestRows(const std::vector<Entry>& entries,
   return best;
 }
 
+std::string milliseconds(double seconds) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%+.1f ms", 1e3 * seconds);
+  return buf;
+}
+
 double median(std::vector<double> v) { return acvo::tools::percentile(std::move(v), 0.5); }
 
 // (max - min) / median of the runs' values, in percent; 0 for a single run.
@@ -365,9 +386,14 @@ void printTable(const std::vector<Row>& rows, const Options& opt) {
   for (int t : opt.threads) threads += (threads.empty() ? "" : ",") + threadsSetting(t);
   std::printf("# acvo on %s; OpenCV odometries serial, as OpenCV's TUM sample runs them (NaN "
               "holes, no guess); times: median over frames, median of %d run%s interleaved "
-              "frame by frame; vs_rgbd: median time / the best RgbdOdometry setting's, per run%s\n",
+              "frame by frame; vs_rgbd: median time / the best RgbdOdometry setting's, per "
+              "run%s%s\n",
               threads.c_str(), opt.repeat, opt.repeat == 1 ? "" : "s",
-              opt.camera.empty() ? "" : ("; camera: " + opt.camera).c_str());
+              opt.camera.empty() ? "" : ("; camera: " + opt.camera).c_str(),
+              opt.offset && *opt.offset != 0.0
+                  ? ("; the frames' stamps " + milliseconds(*opt.offset) + " against the reference's")
+                        .c_str()
+                  : "");
   std::printf("%-20s %-12s %-12s %10s %11s %8s %5s %9s %8s %8s %8s\n", "dataset", "method",
               "setting", "rpe_t_m/s", "rpe_r_deg/s", "ate_m", "lost", "median_ms", "cpu_ms",
               "spread_%", "vs_rgbd");
@@ -395,7 +421,10 @@ void writeJson(const std::vector<Row>& rows, const Options& opt) {
         << ", \"best\": " << (r.best ? "true" : "false")
         << ", \"frames\": " << r.trajectory.size() << ", \"rpe_trans\": " << jsonNumber(r.rpe_trans)
         << ", \"rpe_rot_deg\": " << jsonNumber(r.rpe_rot) << ", \"ate\": " << jsonNumber(r.ate)
-        << ", \"lost\": " << r.lost << ", \"median_ms\": " << jsonNumber(median(r.median_ms))
+        << ", \"lost\": " << r.lost << ", \"offset_s\": " << jsonNumber(r.offset)
+        << ", \"offset_found\": " << (r.offset_found ? "true" : "false") << ", \"offset_refused\": "
+        << (r.offset_refused.empty() ? "null" : acvo::tools::jsonString(r.offset_refused))
+        << ", \"median_ms\": " << jsonNumber(median(r.median_ms))
         << ", \"p90_ms\": " << jsonNumber(median(r.p90_ms))
         << ", \"cpu_median_ms\": " << jsonNumber(median(r.cpu_median_ms))
         << ", \"median_ms_runs\": " << jsonList(r.median_ms)
@@ -420,6 +449,7 @@ int main(int argc, char** argv) {
       return acvo::tools::usageError(app, e.what());
     }
     std::vector<Row> rows;
+    std::vector<std::string> notes;  // printed below the table
     for (const auto& folder : opt.datasets) {
       const acvo::TumDataset data(folder, opt.camera);
       // The dataset's frames used: every stride-th, at most --frames of them.
@@ -437,7 +467,25 @@ int main(int argc, char** argv) {
       std::vector<Entry> entries =
           entriesFor(opt, params, data, dataset, startPose(data, frames.front().stamp));
       for (int run = 0; run < opt.repeat; ++run) runOnce(entries, frames, index, data, run == 0);
-      for (auto& e : entries) evaluate(e.row, data);
+      double offset = opt.offset.value_or(0.0);
+      std::string refused;
+      if (!opt.offset && data.groundtruth()) {
+        std::vector<acvo::Trajectory> trajectories;
+        for (const auto& e : entries) trajectories.push_back(e.row.trajectory);
+        try {
+          offset = acvo::estimateClockOffset(*data.groundtruth(), trajectories).offset;
+          notes.push_back("# " + dataset + ": the frames' stamps " + milliseconds(offset) +
+                          " against the reference's (--offset auto)");
+        } catch (const std::exception& e) {
+          refused = e.what();
+          notes.push_back("# " + dataset + ": evaluated at offset 0: " + refused);
+        }
+      }
+      for (auto& e : entries) {
+        evaluate(e.row, data, offset);
+        e.row.offset_found = !opt.offset && refused.empty() && data.groundtruth();
+        e.row.offset_refused = refused;
+      }
 
       // The best setting of each peer, and the speed ratio to the best RgbdOdometry, per run.
       const auto best = bestRows(entries, opt.label);
@@ -473,6 +521,7 @@ int main(int argc, char** argv) {
       }
     }
     printTable(rows, opt);
+    for (const std::string& note : notes) std::printf("%s\n", note.c_str());
     if (!opt.json.empty()) writeJson(rows, opt);
     return 0;
   } catch (const std::exception& e) {

@@ -34,8 +34,9 @@ evaluate_ate.py) of EST against GT, both TUM trajectories "stamp tx ty tz qx qy 
 
 constexpr const char* kFooter =
     R"(--plot draws the x-y plane and x/y/z over time; it needs /usr/bin/python3 with matplotlib.
-The last line printed is a summary:
-  rpe_trans_rmse=<m> rpe_rot_rmse_deg=<deg> ate_rmse=<m> pairs=<rpe pairs>
+--offset auto prints the offset found and EST's frame-to-frame turn error (RMS, deg) at 0 and at
+it; the figures are then at that offset. The last line printed is a summary:
+  rpe_trans_rmse=<m> rpe_rot_rmse_deg=<deg> ate_rmse=<m> pairs=<rpe pairs> offset=<s>
 Exit status: 0 success, 2 bad arguments or input, 3 the plot could not be made.)";
 
 struct Options {
@@ -43,6 +44,7 @@ struct Options {
   double delta = 1.0;
   acvo::DeltaUnit unit = acvo::DeltaUnit::kSeconds;
   double max_difference = 0.02;
+  std::optional<double> offset = 0.0;  // empty: estimated (--offset auto)
 };
 
 // The command line into `o`; nullopt to go on, else the exit status.
@@ -76,6 +78,10 @@ std::optional<int> parseOptions(CLI::App& app, Options& o, int argc, char** argv
       ->type_name("S")
       ->capture_default_str()
       ->transform(acvo::tools::anyNumber<double>());
+  acvo::tools::addOffsetOption(
+      app, o.offset,
+      "added to EST's stamps where they are looked up in GT (a clock offset; auto: the one at "
+      "which EST's frame-to-frame turns agree best with GT's)");
   app.add_option("--json", o.json, "write every figure as JSON")->type_name("FILE");
   app.add_option("--plot", o.plot, "plot the ATE-aligned estimate against ground truth")
       ->type_name("FILE.png");
@@ -105,11 +111,14 @@ std::string jsonStats(const acvo::ErrorStats& s) {
   return buffer;
 }
 
-void writeJson(const Options& o, const acvo::RpeResult& rpe, const acvo::AteResult& ate) {
+void writeJson(const Options& o, double offset, const acvo::RpeResult& rpe,
+               const acvo::AteResult& ate) {
   std::ofstream out(o.json);
   out.precision(12);
   out << "{\n  \"groundtruth\": " << jsonString(o.groundtruth)
-      << ",\n  \"estimate\": " << jsonString(o.estimate) << ",\n  \"rpe\": {\"delta\": " << o.delta
+      << ",\n  \"estimate\": " << jsonString(o.estimate) << ",\n  \"offset_s\": " << offset
+      << ", \"offset_estimated\": " << (o.offset ? "false" : "true")
+      << ",\n  \"rpe\": {\"delta\": " << o.delta
       << ", \"delta_unit\": " << jsonString(acvo::toString(o.unit)) << ", \"pairs\": " << rpe.pairs
       << ",\n    \"trans_m\": " << jsonStats(rpe.trans)
       << ",\n    \"rot_deg\": " << jsonStats(rpe.rot_deg)
@@ -190,15 +199,28 @@ int main(int argc, char** argv) {
   acvo::Trajectory groundtruth, estimate;
   acvo::RpeResult rpe;
   acvo::AteResult ate;
+  double offset = o.offset.value_or(0.0);
+  std::optional<acvo::ClockOffset> clock;
   try {
     groundtruth = readTrajectoryFile(o.groundtruth);
     estimate = readTrajectoryFile(o.estimate);
-    rpe = acvo::computeRpe(groundtruth, estimate, o.delta, o.unit);
-    ate = acvo::computeAte(groundtruth, estimate, o.max_difference);
-    if (!o.json.empty()) writeJson(o, rpe, ate);
+    if (!o.offset) {
+      clock = acvo::estimateClockOffset(groundtruth, {estimate});
+      offset = clock->offset;
+    }
+    rpe = acvo::computeRpe(groundtruth, estimate, o.delta, o.unit, offset);
+    ate = acvo::computeAte(groundtruth, estimate, o.max_difference, offset);
+    if (!o.json.empty()) writeJson(o, offset, rpe, ate);
   } catch (const std::exception& e) {
     std::cerr << "acvo_eval: " << e.what() << "\n";
     return kError;
+  }
+
+  if (clock) {
+    std::printf("# clock offset, from %zu frame-to-frame turns\n", clock->turns);
+    std::printf("offset %.6f s\n", offset);
+    std::printf("turn_error_rms_at_zero %.6f deg\n", clock->turn_rms_at_zero_deg.front());
+    std::printf("turn_error_rms_at_offset %.6f deg\n", clock->turn_rms_deg.front());
   }
 
   std::printf("# relative pose error, delta %g %s\n", o.delta, acvo::toString(o.unit).c_str());
@@ -218,7 +240,7 @@ int main(int argc, char** argv) {
       plotted = false;
     }
   }
-  std::printf("rpe_trans_rmse=%.9f rpe_rot_rmse_deg=%.9f ate_rmse=%.9f pairs=%zu\n", rpe.trans.rmse,
-              rpe.rot_deg.rmse, ate.trans.rmse, rpe.pairs);
+  std::printf("rpe_trans_rmse=%.9f rpe_rot_rmse_deg=%.9f ate_rmse=%.9f pairs=%zu offset=%.6f\n",
+              rpe.trans.rmse, rpe.rot_deg.rmse, ate.trans.rmse, rpe.pairs, offset);
   return plotted ? 0 : kPlotFailed;
 }

@@ -123,6 +123,28 @@ CLI::Validator anyNumber() {
   }
 }
 
+// --offset S|auto (acvo_eval, acvo_compare): seconds added to the estimates' stamps where they
+// are looked up in the reference (the TUM tools' --offset), or auto: estimated from the
+// frame-to-frame turns (acvo::estimateClockOffset). `offset` is left empty for auto.
+inline CLI::Option* addOffsetOption(CLI::App& app, std::optional<double>& offset,
+                                    const std::string& description) {
+  CLI::Validator seconds = numberIn<double>(-10.0, 10.0, "within [-10, 10] s, or auto");
+  return app
+      .add_option_function<std::string>(
+          "--offset",
+          [&offset](const std::string& text) {
+            offset = text == "auto" ? std::nullopt : std::optional<double>(std::stod(text));
+          },
+          description)
+      ->type_name("S|auto")
+      ->default_str("0")
+      ->transform(CLI::Validator(
+          [seconds](std::string& text) mutable {
+            return text == "auto" ? std::string() : seconds(text);
+          },
+          ""));
+}
+
 // Linear interpolation between order statistics (q in [0, 1]); 0 for an empty list.
 inline double percentile(std::vector<double> v, double q) {
   if (v.empty()) return 0.0;

@@ -10,6 +10,8 @@
 
 #include <gtest/gtest.h>
 
+#include "acvo/tum.hpp"
+#include "clock_fixtures.hpp"
 #include "test_support.hpp"
 
 namespace {
@@ -96,6 +98,33 @@ TEST(AcvoEval, DeltaUnitAndJson) {
   EXPECT_NE(text.str().find("\"delta_unit\": \"deg\""), std::string::npos) << text.str();
   EXPECT_NE(text.str().find("\"pairs\": 23"), std::string::npos) << text.str();
   EXPECT_NE(text.str().find("\"alignment\""), std::string::npos) << text.str();
+}
+
+TEST(AcvoEval, AClockOffsetGivenOrFound) {
+  // A 100 Hz reference and 30 Hz frames whose poses are those 12.3 ms after their stamps.
+  const fs::path dir = acvo::test::tempDir("acvo_eval_offset");
+  const std::string gt = (dir / "gt.txt").string(), est = (dir / "est.txt").string();
+  acvo::writeTrajectory(gt, acvo::test::sampledCamera(100.0, 6.0, 0.0), "reference");
+  acvo::writeTrajectory(est, acvo::test::sampledCamera(30.0, 6.0, 0.0123, 0.05), "frames");
+  const std::string args = "--groundtruth '" + gt + "' --estimate '" + est + "'";
+  const ToolRun plain = runTool(args);
+  ASSERT_EQ(plain.status, 0) << plain.output;
+  EXPECT_EQ(figure(plain.lastLine(), "offset"), 0.0);
+  const ToolRun found = runTool(args + " --offset auto");
+  ASSERT_EQ(found.status, 0) << found.output;
+  EXPECT_NEAR(figure(found.lastLine(), "offset"), 0.0123, 2e-4);
+  EXPECT_NE(found.output.find("# clock offset, from "), std::string::npos) << found.output;
+  EXPECT_NE(found.output.find("turn_error_rms_at_offset "), std::string::npos) << found.output;
+  EXPECT_LT(figure(found.lastLine(), "rpe_rot_rmse_deg"),
+            0.5 * figure(plain.lastLine(), "rpe_rot_rmse_deg"));
+  const ToolRun given = runTool(args + " --offset 0.0123");
+  ASSERT_EQ(given.status, 0) << given.output;
+  EXPECT_EQ(figure(given.lastLine(), "offset"), 0.0123);
+  EXPECT_EQ(given.output.find("# clock offset"), std::string::npos) << given.output;
+  // A reference of one pose per frame has no clock of its own to find; a bad value is refused.
+  EXPECT_EQ(runTool(fixtureArgs("arc_gt.txt", "arc_drift.txt") + " --offset auto").status, 2);
+  EXPECT_EQ(runTool(args + " --offset soon").status, 2);
+  EXPECT_EQ(runTool(args + " --offset 20").status, 2);
 }
 
 TEST(AcvoEval, BadInputExitsWithTwo) {

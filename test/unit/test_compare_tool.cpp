@@ -163,6 +163,37 @@ TEST_F(CompareTool, ASubsetOfMethodsAndItsLabel) {
   EXPECT_EQ(rows[1][10], "nan");  // no RgbdOdometry row to compare the speed with
 }
 
+// --offset: a given one is named in the header line and reaches the JSON; auto refuses a
+// reference of one pose per frame (the synthetic sequence's, which shares the frames' clock) and
+// says so below the table, the figures then at offset 0.
+TEST_F(CompareTool, AClockOffsetGivenOrRefused) {
+  const std::string room = "'" + (dir_ / "room").string() + "' --methods acvo --frames 20";
+  const fs::path plain = dir_ / "offset_plain.txt", given = dir_ / "offset_given.txt";
+  const fs::path json = dir_ / "offset_given.json", automatic = dir_ / "offset_auto.txt";
+  const fs::path auto_json = dir_ / "offset_auto.json";
+  ASSERT_EQ(runTool("acvo_compare", room, plain), 0);
+  ASSERT_EQ(runTool("acvo_compare", room + " --offset 0.01 --json '" + json.string() + "'", given),
+            0);
+  ASSERT_EQ(runTool("acvo_compare", room + " --offset auto --json '" + auto_json.string() + "'",
+                    automatic),
+            0);
+  EXPECT_EQ(count(readText(plain), "against the reference's"), 0);
+  EXPECT_EQ(count(readText(given), "the frames' stamps +10.0 ms against the reference's"), 1);
+  EXPECT_EQ(count(readText(json), "\"offset_s\": 0.01, \"offset_found\": false"), 1);
+  EXPECT_EQ(count(readText(auto_json),
+                  "\"offset_found\": false, \"offset_refused\": \"clock offset: the reference"),
+            1);
+  const std::string text = readText(automatic);
+  EXPECT_EQ(count(text, "# room: evaluated at offset 0: clock offset: the reference is sampled"),
+            1)
+      << text;
+  const auto a = words(automatic), p = words(plain);
+  ASSERT_EQ(a.size(), 2u);
+  ASSERT_EQ(p.size(), 2u);
+  EXPECT_EQ(a[1][3], p[1][3]);  // the translation error, at offset 0 both
+  EXPECT_EQ(a[1][4], p[1][4]);
+}
+
 // --stride 3 uses frames 0, 3, 6, ...: the trajectory has their stamps (--frames counts the
 // frames used), and the dataset is named for the stride.
 TEST_F(CompareTool, StrideUsesEveryKthFrame) {
@@ -265,6 +296,7 @@ TEST_F(CompareTool, BadArgumentsExitWithStatusTwo) {
   EXPECT_EQ(runTool("acvo_compare", room + " --threads -1", out), 2);
   EXPECT_EQ(runTool("acvo_compare", room + " --repeat 0", out), 2);
   EXPECT_EQ(runTool("acvo_compare", room + " --peer-max-depth 0", out), 2);
+  EXPECT_EQ(runTool("acvo_compare", room + " --offset soon", out), 2);
   EXPECT_EQ(runTool("acvo_compare", "'" + (dir_ / "missing").string() + "'", out), 2);
 }
 

@@ -11,6 +11,7 @@
 
 #include "acvo/evaluation.hpp"
 #include "acvo/tum.hpp"
+#include "clock_fixtures.hpp"
 #include "test_support.hpp"
 
 namespace {
@@ -257,6 +258,86 @@ TEST(Evaluation, TooFewPairsThrow) {
   EXPECT_THROW(acvo::computeAte(gt, far), std::runtime_error);
   EXPECT_THROW(acvo::computeRpe(gt, acvo::Trajectory(gt.begin(), gt.begin() + 1)),
                std::runtime_error);
+}
+
+// ---------------------------------------------------------------------------- clock offset
+
+TEST(Evaluation, AnOffsetIsAddedToTheEstimatesStampsAsTheTumToolsAddIt) {
+  // The estimate's stamps 13 ms behind the reference's for the same poses: looked up at
+  // stamp + 0.013 it is the reference itself.
+  const acvo::Trajectory gt = acvo::test::sampledCamera(100.0, 4.0, 0.0);
+  acvo::Trajectory early = gt;
+  for (acvo::StampedPose& p : early) p.stamp -= 0.013;
+  const acvo::RpeResult at_offset =
+      acvo::computeRpe(gt, early, 1.0, DeltaUnit::kSeconds, 0.013);
+  EXPECT_LT(at_offset.trans.rmse, 1e-9);
+  EXPECT_LT(at_offset.rot_deg.rmse, kZeroDeg);
+  EXPECT_LT(acvo::computeAte(gt, early, 0.02, 0.013).trans.rmse, 1e-9);
+  // At offset 0 each pose meets the reference's 10 ms later (the nearest): a turn's error.
+  EXPECT_GT(acvo::computeRpe(gt, early).rot_deg.rmse, 0.1);
+  EXPECT_GT(acvo::computeAte(gt, early).trans.rmse, 1e-4);
+}
+
+TEST(ClockOffset, FoundFromTheFrameToFrameTurns) {
+  // A 100 Hz reference; frames at 30 Hz whose poses are those 12.3 ms after their stamps, each
+  // turned by 0.05 deg of noise.
+  const acvo::Trajectory gt = acvo::test::sampledCamera(100.0, 6.0, 0.0);
+  const acvo::Trajectory frames = acvo::test::sampledCamera(30.0, 6.0, 0.0123, 0.05);
+  const acvo::ClockOffset c = acvo::estimateClockOffset(gt, {frames});
+  EXPECT_NEAR(c.offset, 0.0123, 2e-4);  // found within 0.03 ms
+  EXPECT_GE(c.turns, 170u);
+  ASSERT_EQ(c.turn_rms_deg.size(), 1u);
+  ASSERT_EQ(c.turn_rms_at_zero_deg.size(), 1u);
+  // What is left is the noise: two poses' 0.05 deg each.
+  EXPECT_LT(c.turn_rms_deg[0], 0.1);
+  EXPECT_GT(c.turn_rms_at_zero_deg[0], 2.0 * c.turn_rms_deg[0]);
+  // Evaluated there, the 1-s windows lose most of their error.
+  const double at_zero = acvo::computeRpe(gt, frames).rot_deg.rmse;
+  const double there =
+      acvo::computeRpe(gt, frames, 1.0, DeltaUnit::kSeconds, c.offset).rot_deg.rmse;
+  EXPECT_LT(there, 0.5 * at_zero);
+  // The other way round too.
+  const acvo::Trajectory late = acvo::test::sampledCamera(30.0, 6.0, -0.021, 0.05);
+  EXPECT_NEAR(acvo::estimateClockOffset(gt, {late}).offset, -0.021, 2e-4);
+}
+
+TEST(ClockOffset, AMethodThatLostItsWayDoesNotMoveIt) {
+  // One estimate precise, one with 3 deg of noise per frame (a method that lost its way):
+  // each curve counts relative to its own least value, so the lost one's flat curve adds
+  // little.
+  const acvo::Trajectory gt = acvo::test::sampledCamera(100.0, 6.0, 0.0);
+  const acvo::Trajectory good = acvo::test::sampledCamera(30.0, 6.0, 0.008, 0.05, 1);
+  const acvo::Trajectory lost = acvo::test::sampledCamera(30.0, 6.0, 0.008, 3.0, 2);
+  const acvo::ClockOffset c = acvo::estimateClockOffset(gt, {good, lost});
+  EXPECT_NEAR(c.offset, 0.008, 2e-4);  // within 0.002 ms
+  ASSERT_EQ(c.turn_rms_deg.size(), 2u);
+  EXPECT_GT(c.turn_rms_deg[1], 10.0 * c.turn_rms_deg[0]);
+}
+
+TEST(ClockOffset, RefusedWhereItCannotShow) {
+  const acvo::Trajectory gt = acvo::test::sampledCamera(100.0, 6.0, 0.0);
+  const acvo::Trajectory frames = acvo::test::sampledCamera(30.0, 6.0, 0.01);
+  // A reference of one pose per frame (7-Scenes', the synthetic sequences'): no clock of its own.
+  const acvo::Trajectory per_frame = acvo::test::sampledCamera(30.0, 6.0, 0.0);
+  EXPECT_NE(acvo::test::errorOf([&] { acvo::estimateClockOffset(per_frame, {frames}); })
+                .find("twice as often"),
+            std::string::npos);
+  // A still camera: every offset fits as well.
+  acvo::Trajectory still_gt = gt, still = frames;
+  for (acvo::StampedPose& p : still_gt) p.pose = Eigen::Isometry3d::Identity();
+  for (acvo::StampedPose& p : still) p.pose = Eigen::Isometry3d::Identity();
+  still[5].pose.linear() = Eigen::AngleAxisd(0.01, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  EXPECT_NE(acvo::test::errorOf([&] { acvo::estimateClockOffset(still_gt, {still}); })
+                .find("turns too little"),
+            std::string::npos);
+  // Beyond the search: 80 ms late, searched within 50 ms.
+  const acvo::Trajectory far = acvo::test::sampledCamera(30.0, 6.0, 0.08);
+  EXPECT_NE(acvo::test::errorOf([&] { acvo::estimateClockOffset(gt, {far}); }).find("edge"),
+            std::string::npos);
+  // Too few frames.
+  const acvo::Trajectory few(frames.begin(), frames.begin() + 8);
+  EXPECT_NE(acvo::test::errorOf([&] { acvo::estimateClockOffset(gt, {few}); }).find("at least"),
+            std::string::npos);
 }
 
 }  // namespace
