@@ -384,16 +384,17 @@ std::string jsonList(const std::vector<double>& v) {
 void printTable(const std::vector<Row>& rows, const Options& opt) {
   std::string threads;
   for (int t : opt.threads) threads += (threads.empty() ? "" : ",") + threadsSetting(t);
+  const std::string camera = opt.camera.empty() ? "" : "; camera: " + opt.camera;
+  const std::string offset =
+      opt.offset && *opt.offset != 0.0
+          ? "; the frames' stamps " + milliseconds(*opt.offset) + " against the reference's"
+          : "";
   std::printf("# acvo on %s; OpenCV odometries serial, as OpenCV's TUM sample runs them (NaN "
               "holes, no guess); times: median over frames, median of %d run%s interleaved "
               "frame by frame; vs_rgbd: median time / the best RgbdOdometry setting's, per "
               "run%s%s\n",
-              threads.c_str(), opt.repeat, opt.repeat == 1 ? "" : "s",
-              opt.camera.empty() ? "" : ("; camera: " + opt.camera).c_str(),
-              opt.offset && *opt.offset != 0.0
-                  ? ("; the frames' stamps " + milliseconds(*opt.offset) + " against the reference's")
-                        .c_str()
-                  : "");
+              threads.c_str(), opt.repeat, opt.repeat == 1 ? "" : "s", camera.c_str(),
+              offset.c_str());
   std::printf("%-20s %-12s %-12s %10s %11s %8s %5s %9s %8s %8s %8s\n", "dataset", "method",
               "setting", "rpe_t_m/s", "rpe_r_deg/s", "ate_m", "lost", "median_ms", "cpu_ms",
               "spread_%", "vs_rgbd");

@@ -13,7 +13,8 @@
 namespace acvo::test {
 
 // The pose at time t (s): turning about two axes at rates that change within a second (up to
-// about 60 deg/s, a hand-held camera's), moving along a curve that no screw motion maps onto itself.
+// about 60 deg/s, a hand-held camera's), moving along a curve that no screw motion maps onto
+// itself.
 inline Eigen::Isometry3d wavingCamera(double t) {
   const double yaw = 0.5 * std::sin(2.0 * M_PI * 0.7 * t) + 0.2 * std::sin(2.0 * M_PI * 1.9 * t);
   const double pitch = 0.3 * std::sin(2.0 * M_PI * 1.1 * t + 0.4);
@@ -39,7 +40,8 @@ inline Trajectory sampledCamera(double rate, double seconds, double lag, double 
     Eigen::Isometry3d pose = wavingCamera(t + lag);
     if (noise_deg > 0.0) {
       const Eigen::Vector3d w(normal(rng), normal(rng), normal(rng));
-      pose.linear() = pose.linear() * Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix();
+      pose.linear() =
+          pose.linear() * Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix();
     }
     char text[32];
     std::snprintf(text, sizeof text, "%.6f", 100.0 + t);
