@@ -258,33 +258,31 @@ constexpr std::size_t kMinTurns = 10;       // turns compared, at least
 constexpr double kObservableRise = 1.05;    // the curve's ends over its least value, at least
 constexpr double kReferenceRateRatio = 0.5;  // the reference's interval over the frames', at most
 
-// The reference's orientation at time t (slerp between the poses around it), or none where t
-// is outside it or falls in a gap longer than max_gap.
-std::optional<Eigen::Quaterniond> orientationAt(const Trajectory& gt,
-                                                const std::vector<double>& stamps, double t,
-                                                double max_gap) {
-  const auto after = std::upper_bound(stamps.begin(), stamps.end(), t);
-  if (after == stamps.begin() || after == stamps.end()) return std::nullopt;
-  const std::size_t k = std::size_t(after - stamps.begin());
-  const double t0 = stamps[k - 1], t1 = stamps[k];
-  if (t1 - t0 > max_gap) return std::nullopt;
-  const Eigen::Quaterniond q0(gt[k - 1].pose.linear()), q1(gt[k].pose.linear());
-  return q0.slerp((t - t0) / (t1 - t0), q1);
-}
-
-// The reference, its stamps and the longest interval it is interpolated over.
+// The reference sorted by stamp, its stamps and their median interval.
 struct Reference {
   Trajectory poses;
   std::vector<double> stamps;
-  double max_gap = 0.0;
+  double interval = 0.0;
 };
+
+// The reference's orientation at time t (slerp between the poses around it), or none where t
+// is outside it or falls in a gap longer than twice its median interval (computeRpe's limit).
+std::optional<Eigen::Quaterniond> orientationAt(const Reference& ref, double t) {
+  const auto after = std::upper_bound(ref.stamps.begin(), ref.stamps.end(), t);
+  if (after == ref.stamps.begin() || after == ref.stamps.end()) return std::nullopt;
+  const std::size_t k = std::size_t(after - ref.stamps.begin());
+  const double t0 = ref.stamps[k - 1], t1 = ref.stamps[k];
+  if (t1 - t0 > 2.0 * ref.interval) return std::nullopt;
+  const Eigen::Quaterniond q0(ref.poses[k - 1].pose.linear()), q1(ref.poses[k].pose.linear());
+  return q0.slerp((t - t0) / (t1 - t0), q1);
+}
 
 // The angle (rad) between the estimate's turn from pose a to pose b and the reference's over
 // their stamps + offset; none where the reference does not cover them.
 std::optional<double> turnError(const Reference& ref, const StampedPose& a, const StampedPose& b,
                                 double offset) {
-  const auto ra = orientationAt(ref.poses, ref.stamps, a.stamp + offset, ref.max_gap);
-  const auto rb = orientationAt(ref.poses, ref.stamps, b.stamp + offset, ref.max_gap);
+  const auto ra = orientationAt(ref, a.stamp + offset);
+  const auto rb = orientationAt(ref, b.stamp + offset);
   if (!ra || !rb) return std::nullopt;
   const Eigen::Quaterniond turn(a.pose.linear().transpose() * b.pose.linear());
   return (ra->conjugate() * *rb).angularDistance(turn);
@@ -347,20 +345,19 @@ ClockOffset estimateClockOffset(const Trajectory& groundtruth,
     throw std::runtime_error("clock offset: the reference has fewer than 2 poses");
   }
   ref.stamps = stampsOf(ref.poses);
-  ref.max_gap = 2.0 * medianInterval(ref.stamps);
+  ref.interval = medianInterval(ref.stamps);
   const int half = int(std::lround(max_offset / kOffsetStep));
   if (half < 1) throw std::runtime_error("clock offset: the search range is below its step");
 
   // Between a reference's samples its turn is an interpolation: sampled no faster than the
   // frames, the offset found would be the one at which the interpolation smooths best.
-  const double reference_interval = 0.5 * ref.max_gap;
   std::vector<Trajectory> sorted;
   for (const Trajectory& trajectory : estimates) {
     sorted.push_back(byStamp(trajectory));
     const double frame_interval = medianInterval(stampsOf(sorted.back()));
-    if (sorted.back().size() > 2 && !(reference_interval <= kReferenceRateRatio * frame_interval)) {
+    if (sorted.back().size() > 2 && !(ref.interval <= kReferenceRateRatio * frame_interval)) {
       throw std::runtime_error(
-          "clock offset: the reference is sampled every " + std::to_string(reference_interval) +
+          "clock offset: the reference is sampled every " + std::to_string(ref.interval) +
           " s, not at least twice as often as the frames (every " +
           std::to_string(frame_interval) + " s): its clock cannot be told from its frames'");
     }
