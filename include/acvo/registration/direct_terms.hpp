@@ -2,7 +2,10 @@
 // the reference's images where each moving point projects. The kernel sum brings the clouds
 // within a pixel or two but its width limits how finely it resolves the motion; these terms
 // resolve it to a fraction of a pixel, as direct methods do:
-//  - photometric: the point's grey value against the reference's (DVO, DSO);
+//  - photometric: the point's grey value against the reference's (DVO, DSO), and reversed,
+//    each reference point's grey value against the moving image where it lands (the direction
+//    DVO and DSO warp in: a keyframe's points into the new frame); the engine counts the two
+//    as one term, the reverse at kReverseShare of its weight (coarse_to_fine.hpp);
 //  - point to plane: the point against the plane of the reference's depth there
 //    (projective association, as KinectFusion's ICP), weighed by how much better the depth
 //    is than the depth noise the kernel assumes: full weight on exact depth (a simulator's),
@@ -70,16 +73,18 @@ struct DirectImages {
   // either side; such a point is never used.
   std::vector<float> point_intensity;
   std::vector<std::uint8_t> one_surface;
-  // A reference's whole grey image, smoothed likewise (CV_32FC1; addReferenceImages): moving
-  // points are sampled in it.
+  // The whole grey image, smoothed likewise (CV_32FC1): a reference's (addReferenceImages),
+  // where moving points are sampled, and a moving cloud's where the reverse photometric term
+  // samples the reference's points in it (directImages' whole_image).
   cv::Mat intensity;
   // The depth on a grid of pixels (denseGrid; empty when the dense term is off for this depth)
   // and, for a reference with a grid, the sums of its points (x, y, z, 1) over the 7x7 window
   // around each pixel (CV_32FC4): a window's mean point in one read.
   DepthGrid grid;
   cv::Mat point_sums;
+  bool reference = false;  // addReferenceImages was called
   bool empty() const { return depth.empty(); }
-  bool isReference() const { return !depth.empty() && !intensity.empty(); }
+  bool isReference() const { return reference && !depth.empty() && !intensity.empty(); }
 };
 
 // Smoothing of the grey images (pixels, Gaussian std): rendered images sampled without
@@ -89,8 +94,10 @@ constexpr double kSmoothing = 0.7;
 // From the cloud's grey and depth images (empty when the cloud has none): what a moving cloud
 // needs; with `dense` the depth grid too, unless the cloud's depth was taken at another instant
 // than its colour (LabelledCloud::depth_of_another_instant) or the grid's weight (for
-// depth_noise) is 0.
-DirectImages directImages(const LabelledCloud& cloud, bool dense = false, double depth_noise = 0.0);
+// depth_noise) is 0; with `whole_image` the whole smoothed grey image (the reverse photometric
+// term's).
+DirectImages directImages(const LabelledCloud& cloud, bool dense = false, double depth_noise = 0.0,
+                          bool whole_image = false);
 // The depth grid of a depth image (CV_32FC1 metres, 0 or NaN = none), with its weight for the
 // modelled depth_noise; no points when the weight is 0.
 DepthGrid denseGrid(const cv::Mat& depth, const Camera& camera, double depth_noise);
@@ -156,6 +163,18 @@ struct GreyPair {
 DirectSums photometricSums(const DirectImages& reference, const DirectImages& moving_images,
                            const LabelledCloud& moving, const std::vector<Landing>& landed,
                            bool gain = false, bool vignetting = false);
+
+// The reverse direction, r_i = I_ref(pixel_i) - B_i I_moving(pi(T^-1 x_i)) over the reference's
+// points x_i that land in the moving image (moving_images.intensity, from directImages'
+// whole_image; none without it) on the surface the moving depth has there: one surface at the
+// landing's 4 neighbours and along the moving cloud's motion blur, as a moving point must be at
+// its own pixel. B_i is the brightness the forward term measured (reference = B moving), at the
+// shift rho(pixel_i) - rho(landing). The same left perturbation of T as the forward term's.
+DirectSums reversePhotometricSums(const DirectImages& reference,
+                                  const LabelledCloud& reference_cloud,
+                                  const DirectImages& moving_images,
+                                  const LabelledCloud& moving_cloud, const Eigen::Isometry3d& T,
+                                  const Brightness& brightness);
 
 // The brightness of the pairs (at most kBrightnessPairs of them, evenly spaced) that neither
 // image saturates (both under kSaturated) and that are not dark (both at least kDark: a ratio

@@ -36,6 +36,7 @@ struct LevelDirect {
   const DirectImages* reference = nullptr;
   const DirectImages* moving = nullptr;
   const LabelledCloud* moving_cloud = nullptr;
+  const LabelledCloud* reference_cloud = nullptr;
 };
 
 // The step's quadratic: the kernel's, plus the direct terms' where the level has them. Returns
@@ -59,8 +60,11 @@ double addDirectTerms(const LevelSums& s, double ell, const LevelDirect& direct,
         photometricSums(*direct.reference, *direct.moving, *direct.moving_cloud, landed,
                         p.photometric_gain, p.photometric_vignetting);
     brightness = d.brightness;
-    H += d.H;
-    g += d.g;
+    const DirectSums r =
+        reversePhotometricSums(*direct.reference, *direct.reference_cloud, *direct.moving,
+                               *direct.moving_cloud, T, d.brightness);
+    H += (1.0 - kReverseShare) * d.H + kReverseShare * r.H;
+    g += (1.0 - kReverseShare) * d.g + kReverseShare * r.g;
   }
   if (p.point_to_plane) {
     const DirectSums d = pointToPlaneSums(*direct.reference, landed, planeFadeNoise(p));
@@ -143,7 +147,8 @@ std::shared_ptr<CoarseToFineCloud> prepareCoarseToFine(LabelledCloud cloud,
   auto out = std::make_shared<CoarseToFineCloud>();
   out->cloud = std::move(cloud);
   if (directTerms(p)) {
-    out->images = directImages(out->cloud, p.dense_point_to_plane, planeFadeNoise(p));
+    out->images =
+        directImages(out->cloud, p.dense_point_to_plane, planeFadeNoise(p), p.photometric);
   }
   out->ms_prepare = msSince(t0);
   if (as_reference) prepareCoarseToFineReference(*out, p);
@@ -205,7 +210,7 @@ SolverResult alignCoarseToFine(const CoarseToFineCloud& fixed, const CoarseToFin
     const double eps = p.level_eps * ell / ells.back();
     LevelDirect direct;
     if (last && directTerms(p) && fixed.images.isReference() && !moving.images.empty()) {
-      direct = {&fixed.images, &moving.images, &moving.cloud};
+      direct = {&fixed.images, &moving.images, &moving.cloud, &fixed.cloud};
       if (p.dense_point_to_plane) result.dense_weight = denseWeight(fixed.images, moving.images);
     }
     if (!iterateLevel(*kernel, direct, ell, eps, last, p, T, result)) {

@@ -54,14 +54,15 @@ bool smoothAround(const cv::Mat& depth, const cv::Point& p, float z) {
          sameSurface(depth.at<float>(p.y + 1, p.x), z);
 }
 
-// Whether the depth along point j's blur (its image motion over cloud.blur_motion, centred on
-// its pixel, a pixel more at each end) is the point's own surface: a colour edge blurred over a
-// depth edge gives the points near it the other surface's colour.
+// Whether the depth along the blur of point x of the cloud's frame, seen at pixel p at depth z
+// (its image motion over cloud.blur_motion, centred on p, a pixel more at each end), is x's own
+// surface: a colour edge blurred over a depth edge gives the points near it the other surface's
+// colour.
 constexpr double kMaxBlurCheck = 64.0;  // pixels; a point blurred over more is not used
-bool oneSurfaceAlongBlur(const LabelledCloud& cloud, std::size_t j) {
+bool oneSurfaceAlongBlur(const LabelledCloud& cloud, const Eigen::Vector3d& x, const cv::Point& p,
+                         float z) {
   if (cloud.blur_motion.matrix() == Eigen::Matrix4d::Identity()) return true;
   const Camera& cam = cloud.camera;
-  const Eigen::Vector3d x = cloud.points[j].cast<double>();
   const Eigen::Vector3d y = cloud.blur_motion * x;
   if (!(y.z() > 0.0)) return false;
   const Eigen::Vector2d m(cam.fx * (y.x() / y.z() - x.x() / x.z()),
@@ -69,8 +70,6 @@ bool oneSurfaceAlongBlur(const LabelledCloud& cloud, std::size_t j) {
   const double length = m.norm();
   if (!(length > 1.0)) return true;  // within the 4-neighbours smoothAround checked
   if (!(length < kMaxBlurCheck)) return false;
-  const float z = cloud.points[j].z();
-  const cv::Point& p = cloud.pixels[j];
   const Eigen::Vector2d dir = m / length;
   const double reach = 0.5 * length + 1.0;
   for (double t = -reach; t <= reach; t += 1.0) {
@@ -177,7 +176,20 @@ double weightedMedian(std::vector<std::pair<double, double>>& pairs) {
   return lo != pairs.end() ? lo->first : std::max_element(pairs.begin(), pairs.end())->first;
 }
 
-DirectImages directImages(const LabelledCloud& cloud, bool dense, double depth_noise) {
+namespace {
+
+// The grey image as the terms sample it: in floats, smoothed by kSmoothing.
+cv::Mat smoothedIntensity(const cv::Mat& gray) {
+  cv::Mat out;
+  gray.convertTo(out, CV_32F);
+  cv::GaussianBlur(out, out, cv::Size(0, 0), kSmoothing);
+  return out;
+}
+
+}  // namespace
+
+DirectImages directImages(const LabelledCloud& cloud, bool dense, double depth_noise,
+                          bool whole_image) {
   DirectImages out;
   if (cloud.gray.empty() || cloud.depth.empty() || cloud.pixels.size() != cloud.size()) {
     return out;
@@ -199,8 +211,9 @@ DirectImages directImages(const LabelledCloud& cloud, bool dense, double depth_n
   };
   for (std::size_t j = 0; j < cloud.size(); ++j) {
     const cv::Point& p = cloud.pixels[j];
-    out.one_surface[j] = smoothAround(cloud.depth, p, cloud.points[j].z()) &&
-                         oneSurfaceAlongBlur(cloud, j);
+    const float z = cloud.points[j].z();
+    out.one_surface[j] = smoothAround(cloud.depth, p, z) &&
+                         oneSurfaceAlongBlur(cloud, cloud.points[j].cast<double>(), p, z);
     const bool inside =
         p.x >= half && p.y >= half && p.x + half < g.cols && p.y + half < g.rows;
     float sum = 0.0f;
@@ -219,6 +232,7 @@ DirectImages directImages(const LabelledCloud& cloud, bool dense, double depth_n
   if (dense && !cloud.depth_of_another_instant) {
     out.grid = denseGrid(cloud.depth, cloud.camera, depth_noise);
   }
+  if (whole_image) out.intensity = smoothedIntensity(cloud.gray);
   return out;
 }
 
@@ -304,9 +318,9 @@ DepthGrid denseGrid(const cv::Mat& depth, const Camera& camera, double depth_noi
 }
 
 void addReferenceImages(DirectImages& images, const LabelledCloud& cloud) {
-  if (images.empty() || !images.intensity.empty() || cloud.gray.empty()) return;
-  cloud.gray.convertTo(images.intensity, CV_32F);
-  cv::GaussianBlur(images.intensity, images.intensity, cv::Size(0, 0), kSmoothing);
+  if (images.empty() || images.reference || cloud.gray.empty()) return;
+  if (images.intensity.empty()) images.intensity = smoothedIntensity(cloud.gray);
+  images.reference = true;
   if (images.grid.empty()) return;
   const cv::Mat& D = images.depth;
   const Camera& c = images.camera;
@@ -440,6 +454,59 @@ DirectSums photometricSums(const DirectImages& reference, const DirectImages& mo
       sumsOf(residuals, kMinIntensityScale, kEdgePosition2, [](double) { return 1.0; });
   s.brightness = b;
   return s;
+}
+
+DirectSums reversePhotometricSums(const DirectImages& reference,
+                                  const LabelledCloud& reference_cloud,
+                                  const DirectImages& moving_images,
+                                  const LabelledCloud& moving_cloud, const Eigen::Isometry3d& T,
+                                  const Brightness& brightness) {
+  const cv::Mat& I = moving_images.intensity;
+  const std::size_t n = reference_cloud.size();
+  if (I.empty() || moving_images.empty() || reference.point_intensity.size() != n ||
+      reference.one_surface.size() != n || reference_cloud.pixels.size() != n) {
+    return {};
+  }
+  const Camera& cam = moving_images.camera;
+  const cv::Mat& D = moving_images.depth;
+  auto rho = [&cam](double u, double v) {
+    const double x = (u - cam.cx) / cam.fx, y = (v - cam.cy) / cam.fy;
+    return x * x + y * y;
+  };
+  const Eigen::Isometry3d to_moving = T.inverse();
+  const Eigen::Matrix3d R = T.linear();
+  std::vector<Residual> residuals;
+  residuals.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!reference.one_surface[i]) continue;
+    const Eigen::Vector3d x = reference_cloud.points[i].cast<double>();
+    const Eigen::Vector3d z = to_moving * x;
+    if (!(z.z() > 0.0)) continue;
+    const double u = cam.fx * z.x() / z.z() + cam.cx, v = cam.fy * z.y() / z.z() + cam.cy;
+    if (!(u >= 1.0 && v >= 1.0 && u < D.cols - 2.0 && v < D.rows - 2.0)) continue;
+    const cv::Point at(int(std::lround(u)), int(std::lround(v)));
+    const float depth = float(z.z());
+    if (!sameSurface(D.at<float>(at), depth) || !smoothAround(D, at, depth) ||
+        !oneSurfaceAlongBlur(moving_cloud, z, at, depth)) {
+      continue;
+    }
+    const Eigen::Vector2d grad = bilinearGradient(I, u, v);
+    const double gu = grad.x(), gv = grad.y();
+    // The moving image's d I / d z, then with T <- exp(xi) T: z = T^-1 exp(-xi) x, so
+    // d z = R^T (x x omega - nu), and with e = R d I / d z: d r = -B (e . (x x omega) - e . nu).
+    const double iz = 1.0 / z.z();
+    const Eigen::Vector3d d(gu * cam.fx * iz, gv * cam.fy * iz,
+                            -(gu * cam.fx * z.x() + gv * cam.fy * z.y()) * iz * iz);
+    const Eigen::Vector3d e = R * d;
+    const cv::Point& p = reference_cloud.pixels[i];
+    const double b = brightness.at(rho(p.x, p.y) - rho(u, v));
+    Residual q;
+    q.r = double(reference.point_intensity[i]) - b * double(bilinear(I, u, v));
+    q.say = b * b * (gu * gu + gv * gv);
+    q.J << -b * e.cross(x), b * e;
+    residuals.push_back(q);
+  }
+  return sumsOf(residuals, kMinIntensityScale, kEdgePosition2, [](double) { return 1.0; });
 }
 
 DirectSums pointToPlaneSums(const DirectImages& reference, const std::vector<Landing>& landed,
