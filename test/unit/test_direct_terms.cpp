@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <initializer_list>
 #include <random>
 #include <utility>
 #include <vector>
@@ -454,21 +455,28 @@ TEST(DirectTerms, DensePlaneAloneConverges) {
   }
 }
 
-TEST(DirectTerms, PointsOnADepthEdgeOrOccludedAreLeftOut) {
-  // A 40x30 image: a wall at 2 m, its right half a box face at 1 m. Identity motion.
+// A 40x30 image: a wall at 2 m, its right half (columns 20-39) a box face at 1 m; random grey
+// values (or flat ones), and points at the given pixels.
+LabelledCloud wallAndBox(std::initializer_list<cv::Point> pixels, bool random_grey = true) {
   LabelledCloud c;
   c.width = 40;
   c.height = 30;
   c.camera = Camera{30.0, 30.0, 19.5, 14.5, 40, 30, 1.0};
-  c.gray = cv::Mat(30, 40, CV_8UC1);
-  cv::randu(c.gray, 0, 255);
+  c.gray = cv::Mat(30, 40, CV_8UC1, cv::Scalar(100));
+  if (random_grey) cv::randu(c.gray, 0, 255);
   c.depth = cv::Mat(30, 40, CV_32FC1, cv::Scalar(2.0f));
   c.depth.colRange(20, 40).setTo(1.0f);
-  for (const cv::Point px :
-       {cv::Point(10, 15), cv::Point(19, 15), cv::Point(20, 15), cv::Point(30, 15)}) {
+  for (const cv::Point px : pixels) {
     c.pixels.push_back(px);
     c.points.push_back(c.camera.backProject(px.x, px.y, c.depth.at<float>(px)).cast<float>());
   }
+  return c;
+}
+
+TEST(DirectTerms, PointsOnADepthEdgeOrOccludedAreLeftOut) {
+  // Points inside the wall, beside the edge on either side, inside the box. Identity motion.
+  const LabelledCloud c = wallAndBox(
+      {cv::Point(10, 15), cv::Point(19, 15), cv::Point(20, 15), cv::Point(30, 15)});
   const DirectImages ref = referenceImages(c);
   const DirectImages mov = directImages(c);
   // The two points beside the edge are left out, the two inside each surface kept.
@@ -484,21 +492,10 @@ TEST(DirectTerms, PointsOnADepthEdgeOrOccludedAreLeftOut) {
 // lands on the moving depth's surface, one surface around the landing and along the moving
 // image's blur.
 TEST(DirectTerms, ReverseLandingsOnADepthEdgeOccludedOrBlurredOverOneAreLeftOut) {
-  // The wall and box of PointsOnADepthEdgeOrOccludedAreLeftOut; points 4 px left of the edge,
-  // 4 px right of it, 10 px left of it and inside the box.
-  LabelledCloud c;
-  c.width = 40;
-  c.height = 30;
-  c.camera = Camera{30.0, 30.0, 19.5, 14.5, 40, 30, 1.0};
-  c.gray = cv::Mat(30, 40, CV_8UC1);
-  cv::randu(c.gray, 0, 255);
-  c.depth = cv::Mat(30, 40, CV_32FC1, cv::Scalar(2.0f));
-  c.depth.colRange(20, 40).setTo(1.0f);
-  for (const cv::Point px :
-       {cv::Point(16, 15), cv::Point(24, 15), cv::Point(10, 15), cv::Point(30, 15)}) {
-    c.pixels.push_back(px);
-    c.points.push_back(c.camera.backProject(px.x, px.y, c.depth.at<float>(px)).cast<float>());
-  }
+  // Points 4 px left of the edge (on the wall), 4 px right of it (on the box), 10 px left of it
+  // and inside the box.
+  const LabelledCloud c = wallAndBox(
+      {cv::Point(16, 15), cv::Point(24, 15), cv::Point(10, 15), cv::Point(30, 15)});
   const DirectImages ref = referenceImages(c);
   LabelledCloud moving = c;
   const Eigen::Isometry3d still = Eigen::Isometry3d::Identity();
@@ -512,29 +509,16 @@ TEST(DirectTerms, ReverseLandingsOnADepthEdgeOccludedOrBlurredOverOneAreLeftOut)
   moving.blur_motion = Eigen::Translation3d(0.4, 0.0, 0.0) * Eigen::Isometry3d::Identity();
   EXPECT_EQ(reverseAt(ref, c, directImages(moving, false, 0.0, true), moving, still).used, 2);
   // A landing beside the edge (its 4 neighbours on both surfaces) is left out.
-  LabelledCloud beside = c;
-  beside.pixels = {cv::Point(19, 15), cv::Point(20, 15)};
-  beside.points = {c.camera.backProject(19, 15, 2.0).cast<float>(),
-                   c.camera.backProject(20, 15, 1.0).cast<float>()};
+  const LabelledCloud beside = wallAndBox({cv::Point(19, 15), cv::Point(20, 15)});
   DirectImages beside_ref = referenceImages(beside);
   beside_ref.one_surface.assign(2, 1);  // as if the reference saw them inside a surface
   EXPECT_EQ(reverseAt(beside_ref, beside, directImages(c, false, 0.0, true), c, still).used, 0);
 }
 
 TEST(DirectTerms, PointsWhoseBlurCrossesADepthEdgeAreLeftOut) {
-  // The wall and box of the test above; points 4 px left of the edge (on the wall), 4 px right
-  // of it (on the box) and 10 px left of it.
-  LabelledCloud c;
-  c.width = 40;
-  c.height = 30;
-  c.camera = Camera{30.0, 30.0, 19.5, 14.5, 40, 30, 1.0};
-  c.gray = cv::Mat(30, 40, CV_8UC1, cv::Scalar(100));
-  c.depth = cv::Mat(30, 40, CV_32FC1, cv::Scalar(2.0f));
-  c.depth.colRange(20, 40).setTo(1.0f);
-  for (const cv::Point px : {cv::Point(16, 15), cv::Point(24, 15), cv::Point(10, 15)}) {
-    c.pixels.push_back(px);
-    c.points.push_back(c.camera.backProject(px.x, px.y, c.depth.at<float>(px)).cast<float>());
-  }
+  // Points 4 px left of the edge (on the wall), 4 px right of it (on the box) and 10 px left of
+  // it.
+  LabelledCloud c = wallAndBox({cv::Point(16, 15), cv::Point(24, 15), cv::Point(10, 15)}, false);
   auto kept = [&c](const Eigen::Vector3d& shift) {
     c.blur_motion = Eigen::Translation3d(shift) * Eigen::Isometry3d::Identity();
     const DirectImages images = directImages(c);
