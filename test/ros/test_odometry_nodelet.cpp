@@ -907,17 +907,22 @@ TEST(OdometryNodelet, BlackoutOfBlankFramesIsLostNamedThenTrackingResumes) {
             << " rad\n";
   EXPECT_LT(since_t, kMargin * 0.000173);  // measured 0.172 mm (16UC1), 0.011 mm (32FC1)
   EXPECT_LT(since_r, kMargin * 0.0000935);  // measured 0.093 mrad, 0.0075 mrad
-  // No jump on recovery (REP 105: odom is continuous): the frame that tracks again moves the
-  // published pose by one frame's motion from the held pose, not by the 18 cm the camera
-  // travelled unseen.
+  // No jump on recovery (REP 105: odom is continuous), not by the 18 cm the camera travelled
+  // unseen: where the frame after the blackout was lost and became the reference, the frame that
+  // tracks again moves the published pose by one frame's motion from the held pose; where it
+  // registered again against the last frame before the blackout (the 32FC1 camera: the 0.169 m
+  // unseen found to a few micrometres), the published pose goes on from the held one, as dead
+  // reckoning without a guess has it (ContinuousOdom).
+  const bool bridged = resumed == kBefore + kBlank;
   const Eigen::Isometry3d step = toEigen(out[resumed - 1].odom->pose.pose).inverse() *
                                  toEigen(out[resumed].odom->pose.pose);
-  const Eigen::Isometry3d one = expectedMotion(resumed - 1, resumed);
+  const Eigen::Isometry3d one =
+      bridged ? Eigen::Isometry3d::Identity() : expectedMotion(resumed - 1, resumed);
   const double step_t = (step.translation() - one.translation()).norm();
   const double step_r = angleOf(step.rotation().transpose() * one.rotation());
   std::cout << "[ MEASURED ] blackout without a guess: recovery moves the published pose by "
-            << step.translation().norm() << " m, " << step_t << " m off one frame's motion, "
-            << step_r << " rad\n";
+            << step.translation().norm() << " m, " << step_t << " m off "
+            << (bridged ? "the held pose" : "one frame's motion") << ", " << step_r << " rad\n";
   EXPECT_TRUE(toEigen(out[resumed - 1].odom->pose.pose).isApprox(toEigen(held), kExact));
   EXPECT_LT(step_t, kMargin * 0.000134);  // measured 0.134 mm, 16UC1 (the jump was 18 cm)
   EXPECT_LT(step_r, kMargin * 0.0000780);  // measured 0.078 mrad, 16UC1

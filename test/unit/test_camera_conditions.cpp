@@ -109,21 +109,23 @@ TEST(Sequences, DepthNoiseInBlobsAsARealKinectsCostsLittle) {
     EXPECT_EQ(a[p].lost, 0);
     EXPECT_EQ(b[p].lost, 0);
   }
-  // Measured: per pixel 0.00080 m/s, 0.0174 deg/s (without the dense term 0.00156, 0.0258); in
-  // blobs 0.00158, 0.0282 either way (ICPOdometry loses its precision there: docs/accuracy.md,
-  // tenth round).
-  EXPECT_LT(b[0].rpe.trans.rmse, 1.3 * 0.00158);
-  EXPECT_LT(b[0].rpe.rot_deg.rmse, 1.3 * 0.0282);
-  EXPECT_LT(a[0].rpe.trans.rmse, 1.3 * 0.00080);
-  EXPECT_LT(a[0].rpe.rot_deg.rmse, 1.3 * 0.0174);
+  // Measured: per pixel 0.00075 m/s, 0.0173 deg/s (without the dense term 0.00120, 0.0239); in
+  // blobs 0.00120, 0.0257 either way (with the photometric term's forward direction alone
+  // 0.00080, 0.0174 (0.00156, 0.0258) and 0.00158, 0.0282, docs/accuracy.md thirty-first round;
+  // ICPOdometry loses its precision there: tenth round).
+  EXPECT_LT(b[0].rpe.trans.rmse, 1.3 * 0.00120);
+  EXPECT_LT(b[0].rpe.rot_deg.rmse, 1.3 * 0.0257);
+  EXPECT_LT(a[0].rpe.trans.rmse, 1.3 * 0.00075);
+  EXPECT_LT(a[0].rpe.rot_deg.rmse, 1.3 * 0.0173);
   // Blobs cost the selected points little against noise per pixel.
   EXPECT_LT(b[0].rpe.trans.rmse, 1.3 * a[1].rpe.trans.rmse);
   EXPECT_LT(b[0].rpe.rot_deg.rmse, 1.3 * a[1].rpe.rot_deg.rmse);
-  // The dense term is off in blobs (the same figures to the last digit), and on per pixel halves
-  // the error.
+  // The dense term is off in blobs (the same figures to the last digit), and on per pixel cuts
+  // the error by a third (measured 0.63x, 0.72x; it halved it while the grey values were read in
+  // one direction only, 0.51x, 0.67x).
   EXPECT_EQ(b[0].rpe.trans.rmse, b[1].rpe.trans.rmse);
-  EXPECT_LT(a[0].rpe.trans.rmse, 0.6 * a[1].rpe.trans.rmse);
-  EXPECT_LT(a[0].rpe.rot_deg.rmse, 0.75 * a[1].rpe.rot_deg.rmse);
+  EXPECT_LT(a[0].rpe.trans.rmse, 0.7 * a[1].rpe.trans.rmse);
+  EXPECT_LT(a[0].rpe.rot_deg.rmse, 0.8 * a[1].rpe.rot_deg.rmse);
 }
 
 // Colour from a second camera, as 7-Scenes' (a Kinect's raw depth paired with its colour): 0.897
