@@ -116,6 +116,23 @@ Eigen::Vector2d bilinearGradient(const cv::Mat& image, double u, double v) {
           0.5 * double((1.0f - b) * down(rm, r1) + b * down(r0, r2))};
 }
 
+// The squared distance of pixel (u, v)'s ray from the optical axis, on the plane z = 1: what a
+// lens's vignetting depends on (Brightness::at reads the difference between two pixels').
+double rho(const Camera& cam, double u, double v) {
+  const double x = (u - cam.cx) / cam.fx, y = (v - cam.cy) / cam.fy;
+  return x * x + y * y;
+}
+
+// An image gradient (gu, gv) at the projection of camera point y, carried to y:
+// [gu gv] d pi / d y.
+Eigen::Vector3d gradientAtPoint(const Camera& cam, const Eigen::Vector2d& grad,
+                                const Eigen::Vector3d& y) {
+  const double gu = grad.x(), gv = grad.y();
+  const double iz = 1.0 / y.z();
+  return {gu * cam.fx * iz, gv * cam.fy * iz,
+          -(gu * cam.fx * y.x() + gv * cam.fy * y.y()) * iz * iz};
+}
+
 // One residual, its Jacobian for a left perturbation, and how much it says about the motion
 // (its squared sensitivity to a shift: the squared intensity gradient, or 1).
 struct Residual {
@@ -419,10 +436,6 @@ DirectSums photometricSums(const DirectImages& reference, const DirectImages& mo
                            bool gain, bool vignetting) {
   if (!reference.isReference() || moving_images.point_intensity.size() != moving.size()) return {};
   const Camera& cam = reference.camera;
-  auto rho = [&cam](double u, double v) {
-    const double x = (u - cam.cx) / cam.fx, y = (v - cam.cy) / cam.fy;
-    return x * x + y * y;
-  };
   const bool pixels = moving.pixels.size() == moving.size();
   std::vector<GreyPair> grey(landed.size());
   std::vector<Residual> residuals(landed.size());
@@ -431,9 +444,7 @@ DirectSums photometricSums(const DirectImages& reference, const DirectImages& mo
     const Eigen::Vector2d grad = bilinearGradient(reference.intensity, l.u, l.v);
     const double gu = grad.x(), gv = grad.y();
     // d r / d y = [gu gv] d pi / d y; d y / d xi = [-hat(y), I], and (-hat(y))^T d = y x d.
-    const double iz = 1.0 / l.y.z();
-    const Eigen::Vector3d d(gu * cam.fx * iz, gv * cam.fy * iz,
-                            -(gu * cam.fx * l.y.x() + gv * cam.fy * l.y.y()) * iz * iz);
+    const Eigen::Vector3d d = gradientAtPoint(cam, grad, l.y);
     Residual& q = residuals[k];
     q.say = gu * gu + gv * gv;
     q.J << l.y.cross(d), d;
@@ -442,7 +453,7 @@ DirectSums photometricSums(const DirectImages& reference, const DirectImages& mo
     g.moving = moving_images.point_intensity[l.j];
     if (pixels) {
       const cv::Point& p = moving.pixels[l.j];
-      g.shift = float(rho(l.u, l.v) - rho(p.x, p.y));
+      g.shift = float(rho(cam, l.u, l.v) - rho(cam, p.x, p.y));
     }
     g.flat = float(1.0 / (1.0 + q.say / (kFlatGradient * kFlatGradient)));
   }
@@ -469,10 +480,6 @@ DirectSums reversePhotometricSums(const DirectImages& reference,
   }
   const Camera& cam = moving_images.camera;
   const cv::Mat& D = moving_images.depth;
-  auto rho = [&cam](double u, double v) {
-    const double x = (u - cam.cx) / cam.fx, y = (v - cam.cy) / cam.fy;
-    return x * x + y * y;
-  };
   const Eigen::Isometry3d to_moving = T.inverse();
   const Eigen::Matrix3d R = T.linear();
   std::vector<Residual> residuals;
@@ -494,12 +501,9 @@ DirectSums reversePhotometricSums(const DirectImages& reference,
     const double gu = grad.x(), gv = grad.y();
     // The moving image's d I / d z, then with T <- exp(xi) T: z = T^-1 exp(-xi) x, so
     // d z = R^T (x x omega - nu), and with e = R d I / d z: d r = -B (e . (x x omega) - e . nu).
-    const double iz = 1.0 / z.z();
-    const Eigen::Vector3d d(gu * cam.fx * iz, gv * cam.fy * iz,
-                            -(gu * cam.fx * z.x() + gv * cam.fy * z.y()) * iz * iz);
-    const Eigen::Vector3d e = R * d;
+    const Eigen::Vector3d e = R * gradientAtPoint(cam, grad, z);
     const cv::Point& p = reference_cloud.pixels[i];
-    const double b = brightness.at(rho(p.x, p.y) - rho(u, v));
+    const double b = brightness.at(rho(cam, p.x, p.y) - rho(cam, u, v));
     Residual q;
     q.r = double(reference.point_intensity[i]) - b * double(bilinear(I, u, v));
     q.say = b * b * (gu * gu + gv * gv);
