@@ -45,6 +45,10 @@ bool sameSurface(float a, float b) {
   return a > 0.0f && b > 0.0f && std::abs(a - b) <= kSameSurface * std::min(a, b);
 }
 
+// The pixel nearest to coordinate x > -0.5 (std::lround's answer there): the terms round a few
+// projections per point and iteration, and std::lround is a call into libm.
+int nearestPixel(double x) { return int(x + 0.5); }
+
 // Whether the depth around pixel p (its 4 neighbours) is one surface with depth z.
 bool smoothAround(const cv::Mat& depth, const cv::Point& p, float z) {
   if (p.x < 1 || p.y < 1 || p.x + 1 >= depth.cols || p.y + 1 >= depth.rows) return false;
@@ -73,8 +77,10 @@ bool oneSurfaceAlongBlur(const LabelledCloud& cloud, const Eigen::Vector3d& x, c
   const Eigen::Vector2d dir = m / length;
   const double reach = 0.5 * length + 1.0;
   for (double t = -reach; t <= reach; t += 1.0) {
-    const int u = int(std::lround(p.x + t * dir.x())), v = int(std::lround(p.y + t * dir.y()));
-    if (u < 0 || v < 0 || u >= cloud.depth.cols || v >= cloud.depth.rows ||
+    const double x_t = p.x + t * dir.x(), y_t = p.y + t * dir.y();
+    if (!(x_t > -0.5 && y_t > -0.5)) return false;
+    const int u = nearestPixel(x_t), v = nearestPixel(y_t);
+    if (u >= cloud.depth.cols || v >= cloud.depth.rows ||
         !sameSurface(cloud.depth.at<float>(v, u), z)) {
       return false;
     }
@@ -88,20 +94,15 @@ bool straight(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   return a.cross(b).norm() <= kFold * a.norm() * b.norm();
 }
 
-// Bilinear sample of a CV_32FC1 image at (u, v) in [0, cols - 1) x [0, rows - 1).
-float bilinear(const cv::Mat& image, double u, double v) {
-  const int x = int(u), y = int(v);
-  const float a = float(u - x), b = float(v - y);
-  const float* r0 = image.ptr<float>(y) + x;
-  const float* r1 = image.ptr<float>(y + 1) + x;
-  return (1.0f - b) * ((1.0f - a) * r0[0] + a * r0[1]) + b * ((1.0f - a) * r1[0] + a * r1[1]);
-}
-
-// The bilinear sample at (u, v) of the image's central differences 0.5 (I[x+1] - I[x-1]) and
-// 0.5 (I[y+1] - I[y-1]), from the image itself at (u, v) in [1, cols - 2) x [1, rows - 2): a few
-// thousand samples per iteration, where differentiating a reference's whole image
-// (cv::Sobel) cost a few milliseconds per keyframe.
-Eigen::Vector2d bilinearGradient(const cv::Mat& image, double u, double v) {
+// A grey image's bilinear sample at (u, v) in [1, cols - 2) x [1, rows - 2), and the bilinear
+// sample there of its central differences 0.5 (I[x+1] - I[x-1]) and 0.5 (I[y+1] - I[y-1]), from
+// the 4x4 pixels around it: a few thousand samples per iteration, where differentiating a
+// reference's whole image (cv::Sobel) cost a few milliseconds per keyframe.
+struct GreySample {
+  float value = 0.0f;
+  Eigen::Vector2d gradient = Eigen::Vector2d::Zero();
+};
+GreySample bilinearWithGradient(const cv::Mat& image, double u, double v) {
   const int x = int(u), y = int(v);
   const float a = float(u - x), b = float(v - y);
   const float* rm = image.ptr<float>(y - 1) + x;
@@ -112,8 +113,11 @@ Eigen::Vector2d bilinearGradient(const cv::Mat& image, double u, double v) {
   auto down = [a](const float* lo, const float* hi) {
     return (1.0f - a) * (hi[0] - lo[0]) + a * (hi[1] - lo[1]);
   };
-  return {0.5 * double((1.0f - b) * across(r0) + b * across(r1)),
-          0.5 * double((1.0f - b) * down(rm, r1) + b * down(r0, r2))};
+  GreySample s;
+  s.value = (1.0f - b) * ((1.0f - a) * r0[0] + a * r0[1]) + b * ((1.0f - a) * r1[0] + a * r1[1]);
+  s.gradient = {0.5 * double((1.0f - b) * across(r0) + b * across(r1)),
+                0.5 * double((1.0f - b) * down(rm, r1) + b * down(r0, r2))};
+  return s;
 }
 
 // The squared distance of pixel (u, v)'s ray from the optical axis, on the plane z = 1: what a
@@ -375,7 +379,7 @@ std::vector<Landing> landings(const DirectImages& reference, const DirectImages&
     l.u = cam.fx * l.y.x() / l.y.z() + cam.cx;
     l.v = cam.fy * l.y.y() / l.y.z() + cam.cy;
     if (!(l.u >= 1.0 && l.v >= 1.0 && l.u < D.cols - 2.0 && l.v < D.rows - 2.0)) continue;
-    if (!sameSurface(D.at<float>(int(std::lround(l.v)), int(std::lround(l.u))), float(l.y.z()))) {
+    if (!sameSurface(D.at<float>(nearestPixel(l.v), nearestPixel(l.u)), float(l.y.z()))) {
       continue;
     }
     out.push_back(l);
@@ -441,7 +445,8 @@ DirectSums photometricSums(const DirectImages& reference, const DirectImages& mo
   std::vector<Residual> residuals(landed.size());
   for (std::size_t k = 0; k < landed.size(); ++k) {
     const Landing& l = landed[k];
-    const Eigen::Vector2d grad = bilinearGradient(reference.intensity, l.u, l.v);
+    const GreySample at = bilinearWithGradient(reference.intensity, l.u, l.v);
+    const Eigen::Vector2d& grad = at.gradient;
     const double gu = grad.x(), gv = grad.y();
     // d r / d y = [gu gv] d pi / d y; d y / d xi = [-hat(y), I], and (-hat(y))^T d = y x d.
     const Eigen::Vector3d d = gradientAtPoint(cam, grad, l.y);
@@ -449,7 +454,7 @@ DirectSums photometricSums(const DirectImages& reference, const DirectImages& mo
     q.say = gu * gu + gv * gv;
     q.J << l.y.cross(d), d;
     GreyPair& g = grey[k];
-    g.reference = bilinear(reference.intensity, l.u, l.v);
+    g.reference = at.value;
     g.moving = moving_images.point_intensity[l.j];
     if (pixels) {
       const cv::Point& p = moving.pixels[l.j];
@@ -491,13 +496,14 @@ DirectSums reversePhotometricSums(const DirectImages& reference,
     if (!(z.z() > 0.0)) continue;
     const double u = cam.fx * z.x() / z.z() + cam.cx, v = cam.fy * z.y() / z.z() + cam.cy;
     if (!(u >= 1.0 && v >= 1.0 && u < D.cols - 2.0 && v < D.rows - 2.0)) continue;
-    const cv::Point at(int(std::lround(u)), int(std::lround(v)));
+    const cv::Point at(nearestPixel(u), nearestPixel(v));
     const float depth = float(z.z());
     if (!sameSurface(D.at<float>(at), depth) || !smoothAround(D, at, depth) ||
         !oneSurfaceAlongBlur(moving_cloud, z, at, depth)) {
       continue;
     }
-    const Eigen::Vector2d grad = bilinearGradient(I, u, v);
+    const GreySample sample = bilinearWithGradient(I, u, v);
+    const Eigen::Vector2d& grad = sample.gradient;
     const double gu = grad.x(), gv = grad.y();
     // The moving image's d I / d z, then with T <- exp(xi) T: z = T^-1 exp(-xi) x, so
     // d z = R^T (x x omega - nu), and with e = R d I / d z: d r = -B (e . (x x omega) - e . nu).
@@ -505,7 +511,7 @@ DirectSums reversePhotometricSums(const DirectImages& reference,
     const cv::Point& p = reference_cloud.pixels[i];
     const double b = brightness.at(rho(cam, p.x, p.y) - rho(cam, u, v));
     Residual q;
-    q.r = double(reference.point_intensity[i]) - b * double(bilinear(I, u, v));
+    q.r = double(reference.point_intensity[i]) - b * double(sample.value);
     q.say = b * b * (gu * gu + gv * gv);
     q.J << -b * e.cross(x), b * e;
     residuals.push_back(q);
@@ -522,7 +528,7 @@ DirectSums pointToPlaneSums(const DirectImages& reference, const std::vector<Lan
   std::vector<Residual> residuals;
   residuals.reserve(landed.size());
   for (const Landing& l : landed) {
-    const int u = int(std::lround(l.u)), v = int(std::lround(l.v));
+    const int u = nearestPixel(l.u), v = nearestPixel(l.v);
     if (!smoothAround(D, cv::Point(u, v), D.at<float>(v, u))) continue;
     const Eigen::Vector3d x = pointAt(u, v);
     const Eigen::Vector3d left = x - pointAt(u - 1, v), right = pointAt(u + 1, v) - x;
