@@ -21,6 +21,7 @@
 #pragma once
 
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -146,6 +147,9 @@ struct DirectSums {
   int used = 0;        // residuals summed
   double scale = 0.0;  // their learned scale (grey levels; metres per metre^2 of depth)
   Brightness brightness;  // photometric: the brightness the residuals were measured at
+  // photometric: the variance of an edge's position its residuals say (edgePositionVariance;
+  // NaN where they are too few), px^2
+  double edge_position2 = 0.0;
 };
 
 // A landed point's grey values as brightnessOf reads them.
@@ -156,13 +160,32 @@ struct GreyPair {
   float flat = 1.0f;       // 1 / (1 + |grad I_ref(q)|^2 / kFlatGradient^2)
 };
 
+// The photometric residuals' variance is s^2 + |grad I|^2 p2, s their learned scale and p2 the
+// variance of where an intensity edge lies (DSO's gradient-dependent weight, its constant
+// measured): at least a pixel's quantisation, kEdgePosition2 = 1/12 px^2 (a sensor integrates
+// over its pixel, a renderer samples its centre), and more on a real camera, whose blur,
+// rolling shutter and colour-to-depth registration move its edges. The engine learns p2 from
+// the residuals of the registrations it ran (CoarseToFineEngine), within [kEdgePosition2,
+// kMaxEdgePosition2].
+constexpr double kEdgePosition2 = 1.0 / 12.0;  // px^2
+constexpr double kMaxEdgePosition2 = 1.0;      // px^2
+// The p2 that residuals r with their says |grad I|^2 show: r^2 = s^2 + say p2 fitted through the
+// lower and upper halves of the residuals by say (each half's median r^2, a normal's 0.4549 of
+// its variance, against its median say; medians, so that occluded and moved points count as
+// little as in the scale). Not clamped (negative where the flat residuals are the larger); NaN
+// with fewer than kMinEdgeResiduals in either half.
+constexpr std::size_t kMinEdgeResiduals = 50;
+double edgePositionVariance(const std::vector<std::pair<double, double>>& residual_and_say);
+
 // r_j = I_ref(pi(T z_j)) - B_j I_moving(pixel_j) over the landed points, B_j the brightness
 // from the moving image to the reference at that point: 1, or brightnessOf their grey values
-// (`gain`, `vignetting`). DSO models the same (an affine brightness per frame, a vignetting
-// calibrated offline); here both are measured at every iteration from the points compared.
+// (`gain`, `vignetting`); `edge_position2` the p2 of their variance. DSO models the same (an
+// affine brightness per frame, a vignetting calibrated offline); here both are measured at
+// every iteration from the points compared.
 DirectSums photometricSums(const DirectImages& reference, const DirectImages& moving_images,
                            const LabelledCloud& moving, const std::vector<Landing>& landed,
-                           bool gain = false, bool vignetting = false);
+                           bool gain = false, bool vignetting = false,
+                           double edge_position2 = kEdgePosition2);
 
 // The reverse direction, r_i = I_ref(pixel_i) - B_i I_moving(pi(T^-1 x_i)) over the reference's
 // points x_i that land in the moving image (moving_images.intensity, from directImages'
@@ -174,7 +197,8 @@ DirectSums reversePhotometricSums(const DirectImages& reference,
                                   const LabelledCloud& reference_cloud,
                                   const DirectImages& moving_images,
                                   const LabelledCloud& moving_cloud, const Eigen::Isometry3d& T,
-                                  const Brightness& brightness);
+                                  const Brightness& brightness,
+                                  double edge_position2 = kEdgePosition2);
 
 // The brightness of the pairs (at most kBrightnessPairs of them, evenly spaced) that neither
 // image saturates (both under kSaturated) and that are not dark (both at least kDark: a ratio

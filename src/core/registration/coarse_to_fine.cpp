@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <memory>
 
 #include <Eigen/Cholesky>
@@ -37,13 +38,14 @@ struct LevelDirect {
   const DirectImages* moving = nullptr;
   const LabelledCloud* moving_cloud = nullptr;
   const LabelledCloud* reference_cloud = nullptr;
+  double edge_position2 = kEdgePosition2;  // the photometric residuals' p2 (direct_terms.hpp)
 };
 
 // The step's quadratic: the kernel's, plus the direct terms' where the level has them. Returns
 // the factor that took the kernel's sums to the terms' units.
 double addDirectTerms(const LevelSums& s, double ell, const LevelDirect& direct,
                       const CoarseToFineParams& p, const Eigen::Isometry3d& T, Matrix6d& H,
-                      Vector6d& g, Brightness& brightness) {
+                      Vector6d& g, Brightness& brightness, double& edge_position2) {
   // The kernel's quadratic is sum a_ij (x_i - y)^T W (x_i - y) / 2 ell_j^2 but for the factor
   // ell^2 its sums leave out: divided by ell^2 and by the mean kernel mass of a matched point,
   // each matched point weighs as one position known to ell_j, the scale the terms below are in.
@@ -58,11 +60,21 @@ double addDirectTerms(const LevelSums& s, double ell, const LevelDirect& direct,
   if (p.photometric) {
     const DirectSums d =
         photometricSums(*direct.reference, *direct.moving, *direct.moving_cloud, landed,
-                        p.photometric_gain, p.photometric_vignetting);
+                        p.photometric_gain, p.photometric_vignetting, direct.edge_position2);
     brightness = d.brightness;
     const DirectSums r =
         reversePhotometricSums(*direct.reference, *direct.reference_cloud, *direct.moving,
-                               *direct.moving_cloud, T, d.brightness);
+                               *direct.moving_cloud, T, d.brightness, direct.edge_position2);
+    // What the two directions' residuals say, as they are counted (either alone when the other
+    // had too few).
+    if (!std::isfinite(d.edge_position2)) {
+      edge_position2 = r.edge_position2;
+    } else if (!std::isfinite(r.edge_position2)) {
+      edge_position2 = d.edge_position2;
+    } else {
+      edge_position2 =
+          (1.0 - kReverseShare) * d.edge_position2 + kReverseShare * r.edge_position2;
+    }
     H += (1.0 - kReverseShare) * d.H + kReverseShare * r.H;
     g += (1.0 - kReverseShare) * d.g + kReverseShare * r.g;
   }
@@ -80,10 +92,19 @@ double addDirectTerms(const LevelSums& s, double ell, const LevelDirect& direct,
 }
 
 // Iterates one level from T; returns false when a step was not finite.
-bool iterateLevel(LevelKernel& kernel, const LevelDirect& direct, double ell, double eps, bool last,
-                  const CoarseToFineParams& p, Eigen::Isometry3d& T, SolverResult& result) {
+bool iterateLevel(LevelKernel& kernel, const LevelDirect& level_direct, double ell, double eps,
+                  bool last, const CoarseToFineParams& p, Eigen::Isometry3d& T,
+                  SolverResult& result) {
   Vector6d previous = Vector6d::Zero();
+  LevelDirect direct = level_direct;
   for (int it = 0; it < p.level_iterations; ++it) {
+    // Once the steps are small, this frame's residuals say its own edges' p2 (kEdgePositionGate).
+    const bool settled = it > 0 && std::isfinite(result.edge_position2) &&
+                         previous.head<3>().norm() < kEdgePositionGate * eps &&
+                         previous.tail<3>().norm() < kEdgePositionGate * eps;
+    direct.edge_position2 =
+        settled ? std::clamp(result.edge_position2, kEdgePosition2, kMaxEdgePosition2)
+                : level_direct.edge_position2;
     const auto t0 = Clock::now();
     const LevelSums& s = kernel.evaluate(T, ell);
     Matrix6d H = s.H;
@@ -93,8 +114,11 @@ bool iterateLevel(LevelKernel& kernel, const LevelDirect& direct, double ell, do
     result.hessian = -s.H;
     if (direct.reference) {
       Brightness brightness;
-      const double to_units = addDirectTerms(s, ell, direct, p, T, H, g, brightness);
+      double edge_position2 = std::numeric_limits<double>::quiet_NaN();
+      const double to_units =
+          addDirectTerms(s, ell, direct, p, T, H, g, brightness, edge_position2);
       result.brightness_gain = brightness.gain;
+      result.edge_position2 = edge_position2;
       result.vignetting = brightness.vignetting;
       if (to_units > 0.0) result.hessian = -H / to_units;
     }
@@ -170,7 +194,7 @@ double prepareCoarseToFineReference(CoarseToFineCloud& cloud, const CoarseToFine
 
 SolverResult alignCoarseToFine(const CoarseToFineCloud& fixed, const CoarseToFineCloud& moving,
                                const Eigen::Isometry3d& guess, const CoarseToFineParams& p,
-                               AlignStages stages) {
+                               AlignStages stages, double edge_position2) {
   const auto t_start = Clock::now();
   SolverResult result;
   result.transform = guess;
@@ -210,7 +234,7 @@ SolverResult alignCoarseToFine(const CoarseToFineCloud& fixed, const CoarseToFin
     const double eps = p.level_eps * ell / ells.back();
     LevelDirect direct;
     if (last && directTerms(p) && fixed.images.isReference() && !moving.images.empty()) {
-      direct = {&fixed.images, &moving.images, &moving.cloud, &fixed.cloud};
+      direct = {&fixed.images, &moving.images, &moving.cloud, &fixed.cloud, edge_position2};
       if (p.dense_point_to_plane) result.dense_weight = denseWeight(fixed.images, moving.images);
     }
     if (!iterateLevel(*kernel, direct, ell, eps, last, p, T, result)) {
@@ -248,10 +272,27 @@ double CoarseToFineEngine::prepareReference(PreparedCloud& cloud) const {
   return prepareCoarseToFineReference(static_cast<CoarseToFineCloud&>(cloud), params_);
 }
 
+double EdgePositionMemory::value() const {
+  if (samples_.empty()) return kEdgePosition2;
+  std::vector<double> sorted(samples_.begin(), samples_.end());
+  const auto median = sorted.begin() + std::ptrdiff_t(sorted.size() / 2);
+  std::nth_element(sorted.begin(), median, sorted.end());
+  return std::clamp(*median, kEdgePosition2, kMaxEdgePosition2);
+}
+
+void EdgePositionMemory::add(const SolverResult& r) {
+  if (r.status != SolverStatus::kConverged || !std::isfinite(r.edge_position2)) return;
+  samples_.push_back(r.edge_position2);
+  if (samples_.size() > kEdgePositionSamples) samples_.pop_front();
+}
+
 SolverResult CoarseToFineEngine::align(const PreparedCloud& fixed, const PreparedCloud& moving,
                                        const Eigen::Isometry3d& guess, AlignStages stages) const {
-  return alignCoarseToFine(static_cast<const CoarseToFineCloud&>(fixed),
-                           static_cast<const CoarseToFineCloud&>(moving), guess, params_, stages);
+  SolverResult r = alignCoarseToFine(static_cast<const CoarseToFineCloud&>(fixed),
+                                     static_cast<const CoarseToFineCloud&>(moving), guess,
+                                     params_, stages, edge_position_.value());
+  edge_position_.add(r);
+  return r;
 }
 
 std::optional<Matrix6d> CoarseToFineEngine::covariance(const SolverResult& s,

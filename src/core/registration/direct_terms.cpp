@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <utility>
 #include <vector>
 
@@ -23,11 +24,6 @@ double tukeyWeight(double r, double sd) {
   const double v = 1.0 - u * u;
   return v > 0.0 ? v * v : 0.0;
 }
-// Where an intensity edge lies is known to a pixel's quantisation, 1/sqrt(12) px (a sensor
-// integrates over its pixel, a renderer samples its centre): at a sharp edge this, times the
-// gradient, outweighs the grey-level noise (DSO's gradient-dependent weight, with its constant
-// from the pixel grid).
-constexpr double kEdgePosition2 = 1.0 / 12.0;  // px^2
 // The learned scales stop here: a grey level (the 8-bit quantisation); 1e-5 m at 1 m of depth
 // (a 16-bit PNG at 5000 per metre quantises to 2e-4 m).
 constexpr double kMinIntensityScale = 1.0;
@@ -172,6 +168,13 @@ DirectSums sumsOf(std::vector<Residual>& residuals, double min_scale, double pos
   return s;
 }
 
+double edgePositionOf(const std::vector<Residual>& residuals) {
+  std::vector<std::pair<double, double>> pairs;
+  pairs.reserve(residuals.size());
+  for (const Residual& q : residuals) pairs.emplace_back(q.r, q.say);
+  return edgePositionVariance(pairs);
+}
+
 }  // namespace
 
 double weightedMedian(std::vector<std::pair<double, double>>& pairs) {
@@ -195,6 +198,32 @@ double weightedMedian(std::vector<std::pair<double, double>>& pairs) {
     }
   }
   return lo != pairs.end() ? lo->first : std::max_element(pairs.begin(), pairs.end())->first;
+}
+
+double edgePositionVariance(const std::vector<std::pair<double, double>>& residual_and_say) {
+  const std::size_t n = residual_and_say.size();
+  if (n < 2 * kMinEdgeResiduals) return std::numeric_limits<double>::quiet_NaN();
+  auto median = [](std::vector<double>& v) {
+    const auto m = v.begin() + std::ptrdiff_t(v.size() / 2);
+    std::nth_element(v.begin(), m, v.end());
+    return *m;
+  };
+  std::vector<double> says(n);
+  for (std::size_t k = 0; k < n; ++k) says[k] = residual_and_say[k].second;
+  const double cut = median(says);
+  std::vector<double> r2_low, r2_high, say_low, say_high;
+  for (const auto& [r, say] : residual_and_say) {
+    (say < cut ? r2_low : r2_high).push_back(r * r);
+    (say < cut ? say_low : say_high).push_back(say);
+  }
+  if (r2_low.size() < kMinEdgeResiduals || r2_high.size() < kMinEdgeResiduals) {
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+  const double say_step = median(say_high) - median(say_low);
+  if (!(say_step > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+  // A normal's squared values have their median at 0.4549 of its variance.
+  constexpr double kMedianOfSquares = 0.4549;
+  return (median(r2_high) - median(r2_low)) / (kMedianOfSquares * say_step);
 }
 
 namespace {
@@ -437,7 +466,7 @@ Brightness brightnessOf(const std::vector<GreyPair>& pairs, bool gain, bool vign
 
 DirectSums photometricSums(const DirectImages& reference, const DirectImages& moving_images,
                            const LabelledCloud& moving, const std::vector<Landing>& landed,
-                           bool gain, bool vignetting) {
+                           bool gain, bool vignetting, double edge_position2) {
   if (!reference.isReference() || moving_images.point_intensity.size() != moving.size()) return {};
   const Camera& cam = reference.camera;
   const bool pixels = moving.pixels.size() == moving.size();
@@ -467,8 +496,9 @@ DirectSums photometricSums(const DirectImages& reference, const DirectImages& mo
     residuals[k].r = double(grey[k].reference) - b.at(grey[k].shift) * double(grey[k].moving);
   }
   DirectSums s =
-      sumsOf(residuals, kMinIntensityScale, kEdgePosition2, [](double) { return 1.0; });
+      sumsOf(residuals, kMinIntensityScale, edge_position2, [](double) { return 1.0; });
   s.brightness = b;
+  s.edge_position2 = edgePositionOf(residuals);
   return s;
 }
 
@@ -476,7 +506,7 @@ DirectSums reversePhotometricSums(const DirectImages& reference,
                                   const LabelledCloud& reference_cloud,
                                   const DirectImages& moving_images,
                                   const LabelledCloud& moving_cloud, const Eigen::Isometry3d& T,
-                                  const Brightness& brightness) {
+                                  const Brightness& brightness, double edge_position2) {
   const cv::Mat& I = moving_images.intensity;
   const std::size_t n = reference_cloud.size();
   if (I.empty() || moving_images.empty() || reference.point_intensity.size() != n ||
@@ -516,7 +546,10 @@ DirectSums reversePhotometricSums(const DirectImages& reference,
     q.J << -b * e.cross(x), b * e;
     residuals.push_back(q);
   }
-  return sumsOf(residuals, kMinIntensityScale, kEdgePosition2, [](double) { return 1.0; });
+  DirectSums s =
+      sumsOf(residuals, kMinIntensityScale, edge_position2, [](double) { return 1.0; });
+  s.edge_position2 = edgePositionOf(residuals);
+  return s;
 }
 
 DirectSums pointToPlaneSums(const DirectImages& reference, const std::vector<Landing>& landed,
