@@ -266,7 +266,9 @@ TEST(DirectTerms, ReversePhotometricAloneConvergesToTheTrueMotion) {
   const Pair p = renderedPair(true, false);
   const DirectImages ref = referenceImages(p.a);
   const DirectImages mov = directImages(p.b, false, 0.0, true);
-  EXPECT_EQ(reverseAt(ref, p.a, directImages(p.b), p.b, trueMotion()).used, 0);
+  const DirectSums nothing = reverseAt(ref, p.a, directImages(p.b), p.b, trueMotion());
+  EXPECT_EQ(nothing.used, 0);
+  EXPECT_TRUE(std::isnan(nothing.edge_position2));  // says nothing of the edges either
   const Error e =
       errorOf(iterate([&](const auto& T) { return reverseAt(ref, p.a, mov, p.b, T); }, 8));
   std::printf("  reverse photometric: %.3f mm %.4f deg\n", e.mm, e.deg);

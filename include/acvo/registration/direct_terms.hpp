@@ -23,6 +23,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <utility>
 #include <vector>
 
@@ -148,8 +149,8 @@ struct DirectSums {
   double scale = 0.0;  // their learned scale (grey levels; metres per metre^2 of depth)
   Brightness brightness;  // photometric: the brightness the residuals were measured at
   // photometric: the variance of an edge's position its residuals say (edgePositionVariance;
-  // NaN where they are too few), px^2
-  double edge_position2 = 0.0;
+  // NaN where they are too few or the term had none), px^2
+  double edge_position2 = std::numeric_limits<double>::quiet_NaN();
 };
 
 // A landed point's grey values as brightnessOf reads them.
