@@ -125,6 +125,9 @@ std::vector<Landing> landings(const DirectImages& reference, const DirectImages&
 // sort's answer in linear time: quickselect on the part that holds the crossing). Reorders the
 // pairs, which must not be empty. The terms' learned scales are weighted medians.
 double weightedMedian(std::vector<std::pair<double, double>>& pairs);
+// The upper median of values (the one at size / 2 once sorted), by quickselect; reorders them,
+// which must not be empty.
+double upperMedian(std::vector<double>& values);
 
 // How a point's grey value in the moving image compares with the reference's where it lands:
 // I_ref(q) = gain exp(vignetting (rho(q) - rho(p))) I_moving(p), for a point seen at pixel p in
@@ -177,6 +180,8 @@ constexpr double kMaxEdgePosition2 = 1.0;      // px^2
 // with fewer than kMinEdgeResiduals in either half.
 constexpr std::size_t kMinEdgeResiduals = 50;
 double edgePositionVariance(const std::vector<std::pair<double, double>>& residual_and_say);
+// p2 as the terms use it: within [kEdgePosition2, kMaxEdgePosition2].
+double usableEdgePosition(double p2);
 
 // r_j = I_ref(pi(T z_j)) - B_j I_moving(pixel_j) over the landed points, B_j the brightness
 // from the moving image to the reference at that point: 1, or brightnessOf their grey values

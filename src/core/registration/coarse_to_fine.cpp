@@ -103,8 +103,7 @@ bool iterateLevel(LevelKernel& kernel, const LevelDirect& level_direct, double e
                          previous.head<3>().norm() < kEdgePositionGate * eps &&
                          previous.tail<3>().norm() < kEdgePositionGate * eps;
     direct.edge_position2 =
-        settled ? std::clamp(result.edge_position2, kEdgePosition2, kMaxEdgePosition2)
-                : level_direct.edge_position2;
+        settled ? usableEdgePosition(result.edge_position2) : level_direct.edge_position2;
     const auto t0 = Clock::now();
     const LevelSums& s = kernel.evaluate(T, ell);
     Matrix6d H = s.H;
@@ -274,10 +273,8 @@ double CoarseToFineEngine::prepareReference(PreparedCloud& cloud) const {
 
 double EdgePositionMemory::value() const {
   if (samples_.empty()) return kEdgePosition2;
-  std::vector<double> sorted(samples_.begin(), samples_.end());
-  const auto median = sorted.begin() + std::ptrdiff_t(sorted.size() / 2);
-  std::nth_element(sorted.begin(), median, sorted.end());
-  return std::clamp(*median, kEdgePosition2, kMaxEdgePosition2);
+  std::vector<double> values(samples_.begin(), samples_.end());
+  return usableEdgePosition(upperMedian(values));
 }
 
 void EdgePositionMemory::add(const SolverResult& r) {

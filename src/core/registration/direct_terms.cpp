@@ -201,17 +201,18 @@ double weightedMedian(std::vector<std::pair<double, double>>& pairs) {
   return lo != pairs.end() ? lo->first : std::max_element(pairs.begin(), pairs.end())->first;
 }
 
+double upperMedian(std::vector<double>& values) {
+  const auto m = values.begin() + std::ptrdiff_t(values.size() / 2);
+  std::nth_element(values.begin(), m, values.end());
+  return *m;
+}
+
 double edgePositionVariance(const std::vector<std::pair<double, double>>& residual_and_say) {
   const std::size_t n = residual_and_say.size();
   if (n < 2 * kMinEdgeResiduals) return std::numeric_limits<double>::quiet_NaN();
-  auto median = [](std::vector<double>& v) {
-    const auto m = v.begin() + std::ptrdiff_t(v.size() / 2);
-    std::nth_element(v.begin(), m, v.end());
-    return *m;
-  };
   std::vector<double> says(n);
   for (std::size_t k = 0; k < n; ++k) says[k] = residual_and_say[k].second;
-  const double cut = median(says);
+  const double cut = upperMedian(says);
   std::vector<double> r2_low, r2_high, say_low, say_high;
   for (const auto& [r, say] : residual_and_say) {
     (say < cut ? r2_low : r2_high).push_back(r * r);
@@ -220,12 +221,14 @@ double edgePositionVariance(const std::vector<std::pair<double, double>>& residu
   if (r2_low.size() < kMinEdgeResiduals || r2_high.size() < kMinEdgeResiduals) {
     return std::numeric_limits<double>::quiet_NaN();
   }
-  const double say_step = median(say_high) - median(say_low);
+  const double say_step = upperMedian(say_high) - upperMedian(say_low);
   if (!(say_step > 0.0)) return std::numeric_limits<double>::quiet_NaN();
   // A normal's squared values have their median at 0.4549 of its variance.
   constexpr double kMedianOfSquares = 0.4549;
-  return (median(r2_high) - median(r2_low)) / (kMedianOfSquares * say_step);
+  return (upperMedian(r2_high) - upperMedian(r2_low)) / (kMedianOfSquares * say_step);
 }
+
+double usableEdgePosition(double p2) { return std::clamp(p2, kEdgePosition2, kMaxEdgePosition2); }
 
 namespace {
 
