@@ -136,7 +136,7 @@ inline std::array<PolicyRun, 2> withAndWithoutSecondStart(const synth::SynthSequ
       {Params(), one_start}, int(gt.size()), [&](int i) { return seq.frame(first + i).toFrame(); },
       gt);
   for (int p = 0; p < 2; ++p) {
-    std::printf("  %s: RPE %.5f m/s %.4f deg/s, %d lost, %d second starts (%d kept)\n",
+    std::printf("  %s: RPE %.3g m/s %.3g deg/s, %d lost, %d second starts (%d kept)\n",
                 p == 0 ? "default" : "one start", runs[p].rpe.trans.rmse, runs[p].rpe.rot_deg.rmse,
                 runs[p].lost, runs[p].second_starts, runs[p].second_starts_kept);
     EXPECT_EQ(runs[p].lost, 0);

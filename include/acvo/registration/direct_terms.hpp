@@ -58,9 +58,16 @@ struct DepthGrid {
   // far the shared noise is under the modelled depth noise (1 - shared_noise / (kPlaneFade
   // depth_noise), as the sparse term's fade): exact depth, full weight.
   double weight = 0.0;
+  int stride = 0;  // pixels between the points: kGridStride, or kExactGridStride
   bool empty() const { return points.empty(); }
 };
 constexpr int kGridStride = 10;  // pixels between grid points (3072 on a 640x480 image)
+// ... where the depth is exact, its shared noise under kExactDepthNoise times the modelled depth
+// noise (rendered: at most 0.00006 exact, at least 0.0017 with noise per pixel or in blobs;
+// a Kinect's 0.002): 12288 points. No noise to average, every point is a constraint, as each of
+// ICPOdometry's pixels is (docs/accuracy.md, thirty-fifth round).
+constexpr int kExactGridStride = 5;
+constexpr double kExactDepthNoise = 0.1;
 constexpr int kGridWindow = 3;   // a window's half size: 7x7 pixels
 constexpr int kNormalReach = 4;  // pixels between a plane's window means
 constexpr double kMinIndependence = 0.5;

@@ -340,11 +340,14 @@ DepthGrid denseGrid(const cv::Mat& depth, const Camera& camera, double depth_noi
   const double exact = planeFade(grid.shared_noise, depth_noise);
   grid.weight = std::max(grid.independence >= kMinIndependence ? grid.independence : 0.0, exact);
   if (!(grid.weight > 0.0)) return grid;
+  // The twists above read every kGridStride-th pixel whatever the depth; the points are denser
+  // where it is exact.
+  grid.stride = grid.shared_noise < kExactDepthNoise * depth_noise ? kExactGridStride : kGridStride;
+  const int stride = grid.stride;
   // The window means, over the pixels of the centre's surface.
-  grid.points.reserve(std::size_t(D.rows / kGridStride + 1) *
-                      std::size_t(D.cols / kGridStride + 1));
-  for (int v = kGridStride / 2; v < D.rows; v += kGridStride) {
-    for (int u = kGridStride / 2; u < D.cols; u += kGridStride) {
+  grid.points.reserve(std::size_t(D.rows / stride + 1) * std::size_t(D.cols / stride + 1));
+  for (int v = stride / 2; v < D.rows; v += stride) {
+    for (int u = stride / 2; u < D.cols; u += stride) {
       const float z = D.at<float>(v, u);
       if (!(z > 0.0f) || !smoothAround(D, cv::Point(u, v), z)) continue;
       // Sums of u z, v z and z: the mean point is their back-projection.
