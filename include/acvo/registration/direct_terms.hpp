@@ -58,7 +58,7 @@ struct DepthGrid {
   // far the shared noise is under the modelled depth noise (1 - shared_noise / (kPlaneFade
   // depth_noise), as the sparse term's fade): exact depth, full weight.
   double weight = 0.0;
-  int stride = 0;  // pixels between the points: kGridStride, or kExactGridStride
+  int stride = 0;  // pixels between the points: kGridStride, or kExactGridStride; 0 without points
   bool empty() const { return points.empty(); }
 };
 constexpr int kGridStride = 10;  // pixels between grid points (3072 on a 640x480 image)
