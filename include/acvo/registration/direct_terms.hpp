@@ -133,9 +133,8 @@ std::vector<Landing> landings(const DirectImages& reference, const DirectImages&
 // pairs, which must not be empty. The terms' learned scales are weighted medians.
 double weightedMedian(std::vector<std::pair<double, double>>& pairs);
 // The upper median of values (the one at size / 2 once sorted), by quickselect; reorders them,
-// which must not be empty. The same of the range [begin, end).
+// which must not be empty.
 double upperMedian(std::vector<double>& values);
-double upperMedian(std::vector<double>::iterator begin, std::vector<double>::iterator end);
 
 // How a point's grey value in the moving image compares with the reference's where it lands:
 // I_ref(q) = gain exp(vignetting (rho(q) - rho(p))) I_moving(p), for a point seen at pixel p in

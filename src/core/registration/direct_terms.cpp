@@ -179,9 +179,10 @@ double edgePositionOf(const std::vector<Residual>& residuals) {
 }  // namespace
 
 double weightedMedian(std::vector<std::pair<double, double>>& pairs) {
-  // A weighted quickselect, written out: std::nth_element at the middle index and a sum over the
-  // left half per round partitioned each range several times over (a sixth of the direct terms'
-  // time). One three-way partition per round sums the weights below and at the pivot as it goes.
+  // A weighted quickselect, written out: std::nth_element at the middle index plus a sum over the
+  // left half per round partitioned each range several times over. One three-way partition per
+  // round sums the weights below and at the pivot as it goes (with edgePositionVariance's two
+  // buffers, about 0.3 ms of a 9 ms teddy200 frame).
   double total = 0.0;
   for (const auto& p : pairs) total += p.second;
   const double half = 0.5 * total;
@@ -216,20 +217,27 @@ double weightedMedian(std::vector<std::pair<double, double>>& pairs) {
   return lo != pairs.end() ? lo->first : std::max_element(pairs.begin(), pairs.end())->first;
 }
 
-double upperMedian(std::vector<double>::iterator begin, std::vector<double>::iterator end) {
-  const auto m = begin + (end - begin) / 2;
-  std::nth_element(begin, m, end);
+namespace {
+
+// upperMedian of values[begin, end).
+double upperMedianOf(std::vector<double>& values, std::size_t begin, std::size_t end) {
+  const auto first = values.begin() + std::ptrdiff_t(begin);
+  const auto last = values.begin() + std::ptrdiff_t(end);
+  const auto m = first + (last - first) / 2;
+  std::nth_element(first, m, last);
   return *m;
 }
 
-double upperMedian(std::vector<double>& values) { return upperMedian(values.begin(), values.end()); }
+}  // namespace
+
+double upperMedian(std::vector<double>& values) { return upperMedianOf(values, 0, values.size()); }
 
 double edgePositionVariance(const std::vector<std::pair<double, double>>& residual_and_say) {
   const std::size_t n = residual_and_say.size();
   if (n < 2 * kMinEdgeResiduals) return std::numeric_limits<double>::quiet_NaN();
   std::vector<double> says(n);
   for (std::size_t k = 0; k < n; ++k) says[k] = residual_and_say[k].second;
-  const double cut = upperMedian(says.begin(), says.end());
+  const double cut = upperMedian(says);
   // The halves side by side in two buffers, the lower from the front, the upper from the back
   // (a median does not depend on the order).
   std::vector<double> r2(n);
@@ -242,14 +250,11 @@ double edgePositionVariance(const std::vector<std::pair<double, double>>& residu
   if (low < kMinEdgeResiduals || n - high < kMinEdgeResiduals) {
     return std::numeric_limits<double>::quiet_NaN();
   }
-  auto median = [](std::vector<double>& v, std::size_t begin, std::size_t end) {
-    return upperMedian(v.begin() + std::ptrdiff_t(begin), v.begin() + std::ptrdiff_t(end));
-  };
-  const double say_step = median(says, high, n) - median(says, 0, low);
+  const double say_step = upperMedianOf(says, high, n) - upperMedianOf(says, 0, low);
   if (!(say_step > 0.0)) return std::numeric_limits<double>::quiet_NaN();
   // A normal's squared values have their median at 0.4549 of its variance.
   constexpr double kMedianOfSquares = 0.4549;
-  return (median(r2, high, n) - median(r2, 0, low)) / (kMedianOfSquares * say_step);
+  return (upperMedianOf(r2, high, n) - upperMedianOf(r2, 0, low)) / (kMedianOfSquares * say_step);
 }
 
 double usableEdgePosition(double p2) { return std::clamp(p2, kEdgePosition2, kMaxEdgePosition2); }
