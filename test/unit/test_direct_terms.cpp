@@ -104,36 +104,6 @@ Eigen::Isometry3d iterate(Sums&& sums, int iterations, int min_used = 500) {
   return T;
 }
 
-// The learned scales' weighted median equals the answer of a sort and a running sum, on random
-// values with ties, zero weights and one weight that outweighs all the rest.
-TEST(DirectTerms, WeightedMedianEqualsTheSortedAnswer) {
-  auto sorted = [](std::vector<std::pair<double, double>> v) {
-    std::sort(v.begin(), v.end());
-    double total = 0.0, seen = 0.0;
-    for (const auto& p : v) total += p.second;
-    for (const auto& p : v) {
-      seen += p.second;
-      if (seen >= 0.5 * total) return p.first;
-    }
-    return v.back().first;
-  };
-  std::mt19937 rng(5);
-  std::uniform_int_distribution<int> value(0, 40);  // ties
-  std::uniform_real_distribution<double> weight(0.0, 1.0);
-  for (int n : {1, 2, 3, 10, 101, 2000}) {
-    for (int trial = 0; trial < 20; ++trial) {
-      std::vector<std::pair<double, double>> v;
-      for (int k = 0; k < n; ++k) {
-        const double w = trial % 4 == 0 ? 0.0 : (trial % 4 == 1 ? 1.0 : weight(rng));
-        v.emplace_back(0.1 * value(rng), w);
-      }
-      if (trial % 4 == 3) v[std::size_t(n / 2)].second = 1e6;
-      const double expected = sorted(v);
-      EXPECT_EQ(weightedMedian(v), expected) << "n " << n << " trial " << trial;
-    }
-  }
-}
-
 // Residuals r = n_grey + |grad I| n_position, grey noise of 2 levels and an edge position of
 // variance p2, gradients uniform in [0, 40] levels per pixel: the fit through the two halves
 // finds p2 (measured over 200 draws: 0.290 +- 0.019 for 0.3, 0.0791 for 1/12, 0.0000 for 0;
@@ -176,8 +146,8 @@ TEST(DirectTerms, ResidualsSayWhereTheEdgesLie) {
   const double k = M_PI / 180.0;
   const Eigen::Isometry3d off = expSE3((Vector6d() << 0.05 * k, 0.05 * k, 0, 0, 0, 0).finished());
   auto said = [&](const Eigen::Isometry3d& T) {
-    return std::make_pair(photometricAt(a, b, p.b, T).edge_position2,
-                          reversePhotometricSums(a, p.a, b, p.b, T, Brightness{}).edge_position2);
+    return std::make_pair(photometricAt(a, b, p.b, T).edgePosition2(),
+                          reversePhotometricSums(a, p.a, b, p.b, T, Brightness{}).edgePosition2());
   };
   const auto aligned = said(trueMotion()), misaligned = said(off * trueMotion());
   EXPECT_LT(std::abs(aligned.first), 0.25 * kEdgePosition2);
@@ -268,7 +238,7 @@ TEST(DirectTerms, ReversePhotometricAloneConvergesToTheTrueMotion) {
   const DirectImages mov = directImages(p.b, false, 0.0, true);
   const DirectSums nothing = reverseAt(ref, p.a, directImages(p.b), p.b, trueMotion());
   EXPECT_EQ(nothing.used, 0);
-  EXPECT_TRUE(std::isnan(nothing.edge_position2));  // says nothing of the edges either
+  EXPECT_TRUE(std::isnan(nothing.edgePosition2()));  // says nothing of the edges either
   const Error e =
       errorOf(iterate([&](const auto& T) { return reverseAt(ref, p.a, mov, p.b, T); }, 8));
   std::printf("  reverse photometric: %.3f mm %.4f deg\n", e.mm, e.deg);

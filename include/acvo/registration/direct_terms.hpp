@@ -128,14 +128,6 @@ struct Landing {
 std::vector<Landing> landings(const DirectImages& reference, const DirectImages& moving_images,
                               const LabelledCloud& moving, const Eigen::Isometry3d& T);
 
-// The smallest value v of the (value, weight) pairs whose weights up to v reach half of all (a
-// sort's answer in linear time: quickselect on the part that holds the crossing). Reorders the
-// pairs, which must not be empty. The terms' learned scales are weighted medians.
-double weightedMedian(std::vector<std::pair<double, double>>& pairs);
-// The upper median of values (the one at size / 2 once sorted), by quickselect; reorders them,
-// which must not be empty.
-double upperMedian(std::vector<double>& values);
-
 // How a point's grey value in the moving image compares with the reference's where it lands:
 // I_ref(q) = gain exp(vignetting (rho(q) - rho(p))) I_moving(p), for a point seen at pixel p in
 // the moving image and at q in the reference, rho = ((u - cx) / fx)^2 + ((v - cy) / fy)^2.
@@ -158,9 +150,12 @@ struct DirectSums {
   int used = 0;        // residuals summed
   double scale = 0.0;  // their learned scale (grey levels; metres per metre^2 of depth)
   Brightness brightness;  // photometric: the brightness the residuals were measured at
+  // photometric: the residuals and their says |grad I|^2, for edgePosition2
+  std::vector<std::pair<double, double>> edge_residuals;
   // photometric: the variance of an edge's position its residuals say (edgePositionVariance;
-  // NaN where they are too few or the term had none), px^2
-  double edge_position2 = std::numeric_limits<double>::quiet_NaN();
+  // NaN where they are too few or the term had none), px^2. Computed on demand: five medians
+  // over the residuals, which the engine reads at a level's last iterations only.
+  double edgePosition2() const;
 };
 
 // A landed point's grey values as brightnessOf reads them.

@@ -7,10 +7,12 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <utility>
 
 #include <Eigen/Cholesky>
 
 #include "acvo/covariance.hpp"
+#include "acvo/order_statistics.hpp"
 
 namespace acvo {
 namespace {
@@ -41,11 +43,25 @@ struct LevelDirect {
   double edge_position2 = kEdgePosition2;  // the photometric residuals' p2 (direct_terms.hpp)
 };
 
+// The photometric residuals of an iteration in both directions, kept for what they say of the
+// edges (DirectSums::edgePosition2), which costs five medians each and is read only once the
+// steps are small and at a level's end.
+struct EdgeResiduals {
+  DirectSums forward, reverse;
+  // Either direction's p2 alone when the other had too few residuals; NaN without the term.
+  double p2() const {
+    const double d = forward.edgePosition2(), r = reverse.edgePosition2();
+    if (!std::isfinite(d)) return r;
+    if (!std::isfinite(r)) return d;
+    return (1.0 - kReverseShare) * d + kReverseShare * r;
+  }
+};
+
 // The step's quadratic: the kernel's, plus the direct terms' where the level has them. Returns
 // the factor that took the kernel's sums to the terms' units.
 double addDirectTerms(const LevelSums& s, double ell, const LevelDirect& direct,
                       const CoarseToFineParams& p, const Eigen::Isometry3d& T, Matrix6d& H,
-                      Vector6d& g, Brightness& brightness, double& edge_position2) {
+                      Vector6d& g, Brightness& brightness, EdgeResiduals& edges) {
   // The kernel's quadratic is sum a_ij (x_i - y)^T W (x_i - y) / 2 ell_j^2 but for the factor
   // ell^2 its sums leave out: divided by ell^2 and by the mean kernel mass of a matched point,
   // each matched point weighs as one position known to ell_j, the scale the terms below are in.
@@ -58,25 +74,17 @@ double addDirectTerms(const LevelSums& s, double ell, const LevelDirect& direct,
   const std::vector<Landing> landed =
       landings(*direct.reference, *direct.moving, *direct.moving_cloud, T);
   if (p.photometric) {
-    const DirectSums d =
+    DirectSums d =
         photometricSums(*direct.reference, *direct.moving, *direct.moving_cloud, landed,
                         p.photometric_gain, p.photometric_vignetting, direct.edge_position2);
     brightness = d.brightness;
-    const DirectSums r =
+    DirectSums r =
         reversePhotometricSums(*direct.reference, *direct.reference_cloud, *direct.moving,
                                *direct.moving_cloud, T, d.brightness, direct.edge_position2);
-    // What the two directions' residuals say, as they are counted (either alone when the other
-    // had too few).
-    if (!std::isfinite(d.edge_position2)) {
-      edge_position2 = r.edge_position2;
-    } else if (!std::isfinite(r.edge_position2)) {
-      edge_position2 = d.edge_position2;
-    } else {
-      edge_position2 =
-          (1.0 - kReverseShare) * d.edge_position2 + kReverseShare * r.edge_position2;
-    }
     H += (1.0 - kReverseShare) * d.H + kReverseShare * r.H;
     g += (1.0 - kReverseShare) * d.g + kReverseShare * r.g;
+    edges.forward = std::move(d);
+    edges.reverse = std::move(r);
   }
   if (p.point_to_plane) {
     const DirectSums d = pointToPlaneSums(*direct.reference, landed, planeFadeNoise(p));
@@ -111,28 +119,41 @@ bool iterateLevel(LevelKernel& kernel, const LevelDirect& level_direct, double e
     // The information of the registration: the quadratic's, in the kernel's own units (those
     // covariance_scale was calibrated in).
     result.hessian = -s.H;
+    EdgeResiduals edges;
     if (direct.reference) {
       Brightness brightness;
-      double edge_position2 = std::numeric_limits<double>::quiet_NaN();
-      const double to_units =
-          addDirectTerms(s, ell, direct, p, T, H, g, brightness, edge_position2);
+      const double to_units = addDirectTerms(s, ell, direct, p, T, H, g, brightness, edges);
       result.brightness_gain = brightness.gain;
-      result.edge_position2 = edge_position2;
       result.vignetting = brightness.vignetting;
       if (to_units > 0.0) result.hessian = -H / to_units;
     }
+    // result.edge_position2: what this iteration's residuals say, where it is read: by the next
+    // iteration when this step settles it, and at the level's end.
+    auto sayEdges = [&] {
+      if (!direct.reference) return;
+      const auto t1 = Clock::now();
+      result.edge_position2 = edges.p2();
+      result.ms_neighbours += msSince(t1);
+    };
     result.ms_neighbours += msSince(t0);
     const Eigen::Isometry3d step = levelStep(H, g);
-    if (!step.matrix().allFinite()) return false;
+    if (!step.matrix().allFinite()) {
+      sayEdges();
+      return false;
+    }
     // The direct terms converge as Gauss-Newton does, not as the kernel's slow
     // minorise-maximise: their steps are taken as they are.
     const double acceleration = direct.reference ? 0.0 : p.level_acceleration;
     const Vector6d xi = extrapolatedStep(logSE3(step), previous, acceleration);
+    const bool converged = xi.head<3>().norm() < eps && xi.tail<3>().norm() < eps;
+    const bool settles = xi.head<3>().norm() < kEdgePositionGate * eps &&
+                         xi.tail<3>().norm() < kEdgePositionGate * eps;
+    if (converged || settles || it + 1 == p.level_iterations) sayEdges();
     T = normalized(expSE3(xi) * T);
     previous = xi;
     result.trace.push_back({ell, ell, 1.0, xi.norm(), s.F, s.nnz});
     ++result.iterations;
-    if (xi.head<3>().norm() < eps && xi.tail<3>().norm() < eps) break;
+    if (converged) break;
     if (last && it + 1 == p.level_iterations) result.status = SolverStatus::kMaxIterations;
   }
   return true;

@@ -10,6 +10,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "acvo/order_statistics.hpp"
+
 namespace acvo {
 namespace {
 
@@ -169,68 +171,23 @@ DirectSums sumsOf(std::vector<Residual>& residuals, double min_scale, double pos
   return s;
 }
 
-double edgePositionOf(const std::vector<Residual>& residuals) {
+std::vector<std::pair<double, double>> edgeResidualsOf(const std::vector<Residual>& residuals) {
   std::vector<std::pair<double, double>> pairs;
   pairs.reserve(residuals.size());
   for (const Residual& q : residuals) pairs.emplace_back(q.r, q.say);
-  return edgePositionVariance(pairs);
+  return pairs;
 }
 
 }  // namespace
-
-double weightedMedian(std::vector<std::pair<double, double>>& pairs) {
-  // A weighted quickselect, written out: std::nth_element at the middle index plus a sum over the
-  // left half per round partitioned each range several times over. One three-way partition per
-  // round sums the weights below and at the pivot as it goes (with edgePositionVariance's two
-  // buffers, about 0.3 ms of a 9 ms teddy200 frame).
-  double total = 0.0;
-  for (const auto& p : pairs) total += p.second;
-  const double half = 0.5 * total;
-  auto lo = pairs.begin(), hi = pairs.end();
-  double below = 0.0;  // the weight of the pairs before lo, all smaller
-  while (hi - lo > 1) {
-    const double a = lo->first, b = lo[(hi - lo) / 2].first, c = (hi - 1)->first;
-    const double pivot = std::max(std::min(a, b), std::min(std::max(a, b), c));
-    // [lo, less) < pivot, [less, p) == pivot, [greater, hi) > pivot.
-    auto less = lo, p = lo, greater = hi;
-    double w_less = 0.0, w_equal = 0.0;
-    while (p != greater) {
-      if (p->first < pivot) {
-        w_less += p->second;
-        std::iter_swap(less++, p++);
-      } else if (pivot < p->first) {
-        std::iter_swap(p, --greater);
-      } else {
-        w_equal += p->second;
-        ++p;
-      }
-    }
-    if (below + w_less >= half) {
-      hi = less;
-    } else if (below + w_less + w_equal >= half) {
-      return pivot;
-    } else {
-      below += w_less + w_equal;
-      lo = greater;
-    }
-  }
-  return lo != pairs.end() ? lo->first : std::max_element(pairs.begin(), pairs.end())->first;
-}
 
 namespace {
 
 // upperMedian of values[begin, end).
 double upperMedianOf(std::vector<double>& values, std::size_t begin, std::size_t end) {
-  const auto first = values.begin() + std::ptrdiff_t(begin);
-  const auto last = values.begin() + std::ptrdiff_t(end);
-  const auto m = first + (last - first) / 2;
-  std::nth_element(first, m, last);
-  return *m;
+  return kthSmallest(values.data() + begin, values.data() + end, (end - begin) / 2);
 }
 
 }  // namespace
-
-double upperMedian(std::vector<double>& values) { return upperMedianOf(values, 0, values.size()); }
 
 double edgePositionVariance(const std::vector<std::pair<double, double>>& residual_and_say) {
   const std::size_t n = residual_and_say.size();
@@ -256,6 +213,8 @@ double edgePositionVariance(const std::vector<std::pair<double, double>>& residu
   constexpr double kMedianOfSquares = 0.4549;
   return (upperMedianOf(r2, high, n) - upperMedianOf(r2, 0, low)) / (kMedianOfSquares * say_step);
 }
+
+double DirectSums::edgePosition2() const { return edgePositionVariance(edge_residuals); }
 
 double usableEdgePosition(double p2) { return std::clamp(p2, kEdgePosition2, kMaxEdgePosition2); }
 
@@ -474,9 +433,7 @@ Brightness brightnessOf(const std::vector<GreyPair>& pairs, bool gain, bool vign
     for (std::size_t k = 0; k < usable.size(); ++k) {
       rest[k] = usable[k].log_ratio - v * usable[k].shift;
     }
-    const auto median = rest.begin() + std::ptrdiff_t((rest.size() - 1) / 2);
-    std::nth_element(rest.begin(), median, rest.end());
-    return *median;
+    return kthSmallest(rest.data(), rest.data() + rest.size(), (rest.size() - 1) / 2);
   };
   Brightness b;
   double log_gain = gain ? logGain(0.0) : 0.0;
@@ -534,7 +491,7 @@ DirectSums photometricSums(const DirectImages& reference, const DirectImages& mo
   DirectSums s =
       sumsOf(residuals, kMinIntensityScale, edge_position2, [](double) { return 1.0; });
   s.brightness = b;
-  s.edge_position2 = edgePositionOf(residuals);
+  s.edge_residuals = edgeResidualsOf(residuals);
   return s;
 }
 
@@ -584,7 +541,7 @@ DirectSums reversePhotometricSums(const DirectImages& reference,
   }
   DirectSums s =
       sumsOf(residuals, kMinIntensityScale, edge_position2, [](double) { return 1.0; });
-  s.edge_position2 = edgePositionOf(residuals);
+  s.edge_residuals = edgeResidualsOf(residuals);
   return s;
 }
 
