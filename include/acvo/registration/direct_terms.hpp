@@ -241,8 +241,27 @@ Brightness brightnessOf(const std::vector<GreyPair>& pairs, bool gain, bool vign
 // fold. The weights fade with the learned scale s: (1 - s / (kPlaneFade sqrt(2) depth_noise)),
 // none beyond; depth_noise 0 = exact depth, full weight.
 constexpr double kPlaneFade = 0.5;
+// The reference's plane at the pixels where the moving points landed last, per moving point:
+// a level's iterations land most points at the same pixels again, and their planes (five
+// back-projections and two fold tests each) need not be found again. One per registration of
+// a moving cloud to one reference.
+class PlaneMemo {
+ public:
+  struct Plane {
+    int pixel = -1;  // v * cols + u; -1: none yet
+    bool found = false;  // one surface there, and no fold
+    Eigen::Vector3d x = Eigen::Vector3d::Zero(), n = Eigen::Vector3d::Zero();
+  };
+  Plane& of(std::size_t j) {
+    if (planes_.size() <= j) planes_.resize(j + 1);
+    return planes_[j];
+  }
+
+ private:
+  std::vector<Plane> planes_;
+};
 DirectSums pointToPlaneSums(const DirectImages& reference, const std::vector<Landing>& landed,
-                            double depth_noise);
+                            double depth_noise, PlaneMemo* memo = nullptr);
 // The dense term's weight between a reference and a moving cloud: the moving grid's, 0 when
 // either has no grid (the reference's window sums are built only with its own grid).
 double denseWeight(const DirectImages& reference, const DirectImages& moving_images);

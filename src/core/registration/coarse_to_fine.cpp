@@ -61,7 +61,8 @@ struct EdgeResiduals {
 // the factor that took the kernel's sums to the terms' units.
 double addDirectTerms(const LevelSums& s, double ell, const LevelDirect& direct,
                       const CoarseToFineParams& p, const Eigen::Isometry3d& T, Matrix6d& H,
-                      Vector6d& g, Brightness& brightness, EdgeResiduals& edges) {
+                      Vector6d& g, Brightness& brightness, EdgeResiduals& edges,
+                      PlaneMemo& planes) {
   // The kernel's quadratic is sum a_ij (x_i - y)^T W (x_i - y) / 2 ell_j^2 but for the factor
   // ell^2 its sums leave out: divided by ell^2 and by the mean kernel mass of a matched point,
   // each matched point weighs as one position known to ell_j, the scale the terms below are in.
@@ -87,7 +88,7 @@ double addDirectTerms(const LevelSums& s, double ell, const LevelDirect& direct,
     edges.reverse = std::move(r);
   }
   if (p.point_to_plane) {
-    const DirectSums d = pointToPlaneSums(*direct.reference, landed, planeFadeNoise(p));
+    const DirectSums d = pointToPlaneSums(*direct.reference, landed, planeFadeNoise(p), &planes);
     H += d.H;
     g += d.g;
   }
@@ -105,6 +106,7 @@ bool iterateLevel(LevelKernel& kernel, const LevelDirect& level_direct, double e
                   SolverResult& result) {
   Vector6d previous = Vector6d::Zero();
   LevelDirect direct = level_direct;
+  PlaneMemo planes;
   for (int it = 0; it < p.level_iterations; ++it) {
     // Once the steps are small, this frame's residuals say its own edges' p2 (kEdgePositionGate).
     const bool settled = it > 0 && std::isfinite(result.edge_position2) &&
@@ -122,7 +124,8 @@ bool iterateLevel(LevelKernel& kernel, const LevelDirect& level_direct, double e
     EdgeResiduals edges;
     if (direct.reference) {
       Brightness brightness;
-      const double to_units = addDirectTerms(s, ell, direct, p, T, H, g, brightness, edges);
+      const double to_units =
+          addDirectTerms(s, ell, direct, p, T, H, g, brightness, edges, planes);
       result.brightness_gain = brightness.gain;
       result.vignetting = brightness.vignetting;
       if (to_units > 0.0) result.hessian = -H / to_units;

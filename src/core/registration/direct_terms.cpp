@@ -555,23 +555,34 @@ DirectSums reversePhotometricSums(const DirectImages& reference,
 }
 
 DirectSums pointToPlaneSums(const DirectImages& reference, const std::vector<Landing>& landed,
-                            double depth_noise) {
+                            double depth_noise, PlaneMemo* memo) {
   if (reference.empty()) return {};
   const Camera& cam = reference.camera;
   const cv::Mat& D = reference.depth;
   auto pointAt = [&](int u, int v) { return cam.backProject(u, v, double(D.at<float>(v, u))); };
+  // The reference's plane at pixel (u, v).
+  auto planeAt = [&](int u, int v, PlaneMemo::Plane& plane) {
+    plane.pixel = v * D.cols + u;
+    plane.found = false;
+    if (!smoothAround(D, cv::Point(u, v), D.at<float>(v, u))) return;
+    plane.x = pointAt(u, v);
+    const Eigen::Vector3d left = plane.x - pointAt(u - 1, v), right = pointAt(u + 1, v) - plane.x;
+    const Eigen::Vector3d up = plane.x - pointAt(u, v - 1), down = pointAt(u, v + 1) - plane.x;
+    // A plane only: a fold (a corner of two walls, a box's edge) has no normal.
+    if (!straight(left, right) || !straight(up, down)) return;
+    plane.n = (left + right).cross(up + down).normalized();
+    plane.found = plane.n.allFinite();
+  };
   std::vector<Residual> residuals;
   residuals.reserve(landed.size());
+  PlaneMemo::Plane here;
   for (const Landing& l : landed) {
     const int u = nearestPixel(l.u), v = nearestPixel(l.v);
-    if (!smoothAround(D, cv::Point(u, v), D.at<float>(v, u))) continue;
-    const Eigen::Vector3d x = pointAt(u, v);
-    const Eigen::Vector3d left = x - pointAt(u - 1, v), right = pointAt(u + 1, v) - x;
-    const Eigen::Vector3d up = x - pointAt(u, v - 1), down = pointAt(u, v + 1) - x;
-    // A plane only: a fold (a corner of two walls, a box's edge) has no normal.
-    if (!straight(left, right) || !straight(up, down)) continue;
-    const Eigen::Vector3d n = (left + right).cross(up + down).normalized();
-    if (!n.allFinite()) continue;
+    PlaneMemo::Plane& plane = memo ? memo->of(l.j) : here;
+    if (plane.pixel != v * D.cols + u) planeAt(u, v, plane);
+    if (!plane.found) continue;
+    const Eigen::Vector3d& x = plane.x;
+    const Eigen::Vector3d& n = plane.n;
     // Depth noise grows with z^2: residuals in metres per metre^2 share one scale.
     const double inv_z2 = 1.0 / (l.y.z() * l.y.z());
     Residual q{n.dot(l.y - x) * inv_z2, Vector6d(), 1.0};
