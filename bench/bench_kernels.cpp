@@ -2,7 +2,7 @@
 // of real frames (see frame_pair.hpp): pixel selection, cloud building, the depth moved to the
 // colour's time; for the default engine
 // a reference's search grids, the kernel pass of a level (fresh and with warm candidate lists),
-// the last level's direct terms, a frame's depth grid for the dense term and a whole
+// the last level's direct terms and their medians, a frame's depth grid for the dense term and a whole
 // registration; for the paper's engine the cloud preparation (search grid and
 // self-kernel pairs), its kernel pass, the step-size sums, the self-kernel sums and a whole
 // registration.
@@ -14,12 +14,15 @@
 // The kernel passes run at the transform the default engine converges to, at ell in millimetres
 // (the default engine's ell_min and ell_init, the paper's ell_min and ell_max). Times are wall-clock ("Time"): the
 // work is spread over the arena's threads, which the "CPU" column (main thread) does not see.
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <benchmark/benchmark.h>
@@ -28,6 +31,7 @@
 
 #include "acvo/depth.hpp"
 #include "acvo/labelled_cloud.hpp"
+#include "acvo/order_statistics.hpp"
 #include "acvo/point_selector.hpp"
 #include "frame_pair.hpp"
 
@@ -188,6 +192,69 @@ void BM_DirectTerms(benchmark::State& state) {
   state.counters["residuals"] = used;
 }
 BENCHMARK(BM_DirectTerms)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The direct terms' order statistics on the pair's own photometric residuals at one iterate:
+// the upper median of their says |grad I|^2 by std::nth_element and by kthSmallest (the edge
+// fit takes five of these per term and iteration), and the weighted median of (|r|, say) that
+// learns the scale. Each iteration copies the values first (both rows alike), as the terms fill
+// theirs, from one of 64 orders of them: the same values in the same order every time would
+// let the branch predictor learn std::nth_element's comparisons, which an iteration's new
+// residuals never repeat.
+constexpr int kOrders = 64;
+template <typename T>
+std::vector<std::vector<T>> shuffledOrders(const std::vector<T>& values) {
+  std::vector<std::vector<T>> orders(kOrders, values);
+  std::mt19937 rng(1);
+  for (auto& o : orders) std::shuffle(o.begin(), o.end(), rng);
+  return orders;
+}
+
+std::vector<std::pair<double, double>> photometricResiduals() {
+  const std::vector<acvo::Landing> landed = acvo::landings(
+      g_pair->fixed->images, g_pair->moving->images, g_pair->moving->cloud, g_pair->aligned);
+  return acvo::photometricSums(g_pair->fixed->images, g_pair->moving->images,
+                               g_pair->moving->cloud, landed)
+      .edge_residuals;
+}
+
+void BM_UpperMedian(benchmark::State& state) {
+  std::vector<double> says;
+  for (const auto& [r, say] : photometricResiduals()) says.push_back(say);
+  const auto orders = shuffledOrders(says);
+  std::vector<double> v;
+  double median = 0.0;
+  std::size_t k = 0;
+  for (auto _ : state) {
+    v = orders[k++ % kOrders];
+    if (state.range(0) == 0) {
+      std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(v.size() / 2), v.end());
+      median = v[v.size() / 2];
+    } else if (state.range(0) == 1) {
+      median = acvo::upperMedian(v);
+    } else {
+      median = v[v.size() / 2];
+    }
+    benchmark::DoNotOptimize(median);
+  }
+  const char* labels[] = {"std::nth_element", "kthSmallest", "the copy alone"};
+  state.SetLabel(labels[state.range(0)]);
+  state.counters["values"] = double(says.size());
+}
+BENCHMARK(BM_UpperMedian)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond);
+
+void BM_WeightedMedian(benchmark::State& state) {
+  std::vector<std::pair<double, double>> pairs = photometricResiduals();
+  for (auto& [r, say] : pairs) r = std::abs(r);
+  const auto orders = shuffledOrders(pairs);
+  std::vector<std::pair<double, double>> v;
+  std::size_t k = 0;
+  for (auto _ : state) {
+    v = orders[k++ % kOrders];
+    benchmark::DoNotOptimize(acvo::weightedMedian(v));
+  }
+  state.counters["values"] = double(pairs.size());
+}
+BENCHMARK(BM_WeightedMedian)->Unit(benchmark::kMicrosecond);
 
 // A frame's depth grid for the dense term: the twists that decide it, and the window means where
 // it is on (real Kinect frames: off, the twists alone; the synthetic pair, noise per pixel: on).
