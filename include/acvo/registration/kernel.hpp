@@ -201,9 +201,10 @@ void VoxelGrid::forEachRun(const Eigen::Vector3f& q, float radius, F&& f) const 
       const auto end = z_.begin() + column_start_[std::size_t(column) + 1];
       // A third of the columns a query covers are empty, a sixth hold no point in its z range.
       if (begin == end || end[-1] < z_lo || *begin > z_hi) continue;
+      // Both ends by binary search: a column a query reaches holds 35-40 points, 25 of them in
+      // its z range (teddy200), which a scan for the far end read one by one.
       const auto first = std::lower_bound(begin, end, z_lo);
-      auto last = first;
-      while (last != end && *last <= z_hi) ++last;
+      const auto last = std::upper_bound(first, end, z_hi);
       if (last != first) f(int(first - z_.begin()), int(last - z_.begin()));
     }
   }
