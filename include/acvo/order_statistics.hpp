@@ -3,10 +3,10 @@
 // partitions around one pivot per round, and on values in no order it mispredicts about half
 // of its comparisons: in `perf record` over teddy200 its medians and the weighted median were
 // about a tenth of a frame. Here a pass without branches first keeps only the values between
-// two pivots read from a sorted sample around the wanted rank (a few percent of them), and
-// std::nth_element finishes there. `acvo_bench_kernels --threads=1 --benchmark_filter=Median`
-// (the upper median of a frame pair's 2755-3299 photometric says): 24-31 us by
-// std::nth_element, 11.5 us here.
+// two pivots read from a sorted sample around the wanted rank (about a fifth of them, again
+// while more than 256 are left), and std::nth_element finishes there. `acvo_bench_kernels
+// --threads=1 --benchmark_filter=Median` (the upper median of a frame pair's 2755-3299
+// photometric says): 24-31 us by std::nth_element, 11.5 us here.
 #pragma once
 
 #include <cstddef>
