@@ -1,6 +1,7 @@
 // Kernel, sparsification and neighbour structures (docs/method.md §2, §5).
 #include <gtest/gtest.h>
 
+#include "acvo/registration/coarse_to_fine.hpp"
 #include "acvo/registration/kernel.hpp"
 #include "acvo/registration/paper.hpp"
 #include "acvo/registration/paper_kernel.hpp"
@@ -98,6 +99,87 @@ TEST(PaperKernel, EqualsBruteForceOnRandomClouds) {
     EXPECT_NEAR(s.F_d2, b.F_d2, 1e-3 * b.F_d2 + 1e-5);
     EXPECT_LT((s.omega * p.omega_scale - b.omega_sum).norm(), 1e-3 * b.omega_sum.norm() + 1e-4);
     EXPECT_LT((s.v * p.v_scale - b.v_sum).norm(), 1e-3 * b.v_sum.norm() + 1e-4);
+  }
+}
+
+// The default engine's kernel pass against its definition (docs/method.md §6), pair by pair in
+// double: each moving point's own length-scale (ell z / ell_depth_reference) and depth noise
+// along its ray (kappa), the radius and threshold tests, and the moments its H is made of.
+LevelSums levelSumsByBruteForce(const LabelledCloud& X, const LabelledCloud& Z,
+                                const Eigen::Isometry3d& T, double ell,
+                                const CoarseToFineParams& p) {
+  const double r2_unit = spatialRadius2(ell, p.sigma, p.sparsification);
+  const double color_inv = 1.0 / (2.0 * p.color_ell * p.color_ell);
+  LevelSums s;
+  double m0 = 0.0;
+  Eigen::Vector3d m1 = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d m2 = Eigen::Matrix3d::Zero(), along = Eigen::Matrix3d::Zero();
+  for (std::size_t j = 0; j < Z.size(); ++j) {
+    const double z = Z.points[j].z();
+    const double scale = ellScale(float(z), p), noise = p.depth_noise * z * z;
+    const double l = ell * scale;
+    const double kappa = 2.0 * noise * noise / (l * l + 2.0 * noise * noise);
+    const double search = std::min(scale / std::sqrt(1.0 - kappa), double(kMaxEllScale));
+    const Eigen::Vector3d y = T * Z.points[j].cast<double>(), ray = y.normalized();
+    double a_sum = 0.0;
+    Eigen::Vector3d x_sum = Eigen::Vector3d::Zero();
+    for (std::size_t i = 0; i < X.size(); ++i) {
+      const Eigen::Vector3d d = X.points[i].cast<double>() - y;
+      const double label_d2 = (X.labels[i] - Z.labels[j]).cast<double>().squaredNorm();
+      const double a = p.sigma * p.sigma *
+                       std::exp(-(d.squaredNorm() - kappa * d.dot(ray) * d.dot(ray)) /
+                                (2.0 * l * l)) *
+                       p.color_sigma * p.color_sigma * std::exp(-label_d2 * color_inv);
+      if (d.squaredNorm() >= r2_unit * search * search || a < p.sparsification) continue;
+      a_sum += a;
+      x_sum += a * X.points[i].cast<double>();
+      ++s.nnz;
+    }
+    s.F += a_sum;
+    if (!(a_sum > 0.0)) continue;
+    ++s.matched;
+    const double s2 = scale * scale, wa = a_sum / s2;
+    m0 += wa;
+    m1 += wa * y;
+    m2 += wa * y * y.transpose();
+    along += wa * kappa * ray * ray.transpose();
+    const Eigen::Vector3d e = (x_sum - a_sum * y) / s2;
+    const Eigen::Vector3d we = e - kappa * ray * ray.dot(e);
+    s.g.head<3>() += y.cross(we);
+    s.g.tail<3>() += we;
+  }
+  s.H.topLeftCorner<3, 3>() = m2.trace() * Eigen::Matrix3d::Identity() - m2;
+  s.H.topRightCorner<3, 3>() = hat(m1);
+  s.H.bottomLeftCorner<3, 3>() = hat(m1).transpose();
+  s.H.bottomRightCorner<3, 3>() = m0 * Eigen::Matrix3d::Identity() - along;
+  return s;
+}
+
+TEST(LevelKernel, EqualsBruteForceWithLongAndShortLists) {
+  CoarseToFineParams p;
+  p.color_ell = 0.3;  // the fixtures' labels vary smoothly: most pairs in reach pass on colour
+  const LabelledCloud X = test::randomCloud(1500, 5, 0.5f);
+  const Eigen::Isometry3d motion =
+      expSE3((Vector6d() << 0.01, -0.02, 0.01, 0.01, 0.02, -0.01).finished());
+  const LabelledCloud Z = test::transformed(test::randomCloud(1500, 5, 0.5f), motion.inverse());
+  const Eigen::Isometry3d T = expSE3((Vector6d() << 0.002, 0.0, -0.001, 0.003, -0.002, 0.001)
+                                         .finished()) * motion;
+  // A list per moving point of some hundreds of candidates at 50 mm, a few at 8 mm (the pass
+  // sums short and long lists differently).
+  for (double ell : {0.05, 0.02, 0.008}) {
+    const VoxelGrid grid(X.points, gridCell(ell, p.sigma, p.sparsification));
+    LevelKernel kernel(X, Z, grid, p);
+    const LevelSums& s = kernel.evaluate(T, ell);
+    const LevelSums b = levelSumsByBruteForce(X, Z, T, ell, p);
+    ASSERT_GT(b.nnz, 1000) << "the test needs overlapping clouds";
+    const double per_point = double(b.nnz) / double(Z.size());
+    EXPECT_TRUE(ell > 0.01 ? per_point > 8.0 : per_point < 4.0) << ell << ": " << per_point;
+    // Pairs within float rounding of a test's bound may differ: allow a handful.
+    EXPECT_NEAR(double(s.nnz), double(b.nnz), 3.0) << "ell " << ell;
+    EXPECT_NEAR(double(s.matched), double(b.matched), 3.0) << "ell " << ell;
+    EXPECT_NEAR(s.F, b.F, 1e-4 * b.F + 3 * p.sparsification) << "ell " << ell;
+    EXPECT_LT((s.g - b.g).norm(), 1e-3 * b.g.norm() + 1e-3) << "ell " << ell;
+    EXPECT_LT((s.H - b.H).norm(), 1e-4 * b.H.norm()) << "ell " << ell;
   }
 }
 
