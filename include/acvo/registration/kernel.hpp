@@ -5,6 +5,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <utility>
@@ -77,6 +78,11 @@ class VoxelGrid {
   void forEachRun(const Eigen::Vector3f& q, float radius, F&& f) const;
   int index(int k) const { return order_[std::size_t(k)]; }
   const Eigen::Vector3f& point(int k) const { return points_[std::size_t(k)]; }
+  // The points' coordinates in the same order, one array each (for loops over a run that the
+  // compiler vectorises).
+  const float* xs() const { return x_.data(); }
+  const float* ys() const { return y_.data(); }
+  const float* zs() const { return z_.data(); }
   int size() const { return int(order_.size()); }
   // forEachWithin(q, cell()).
   template <typename F>
@@ -90,7 +96,7 @@ class VoxelGrid {
   int nx_ = 0, ny_ = 0;
   std::vector<int> column_start_;  // size nx*ny + 1
   std::vector<int> order_;         // point indices by column, by z within a column
-  std::vector<float> z_;           // their z, in the same order
+  std::vector<float> x_, y_, z_;   // their coordinates, in the same order
   std::vector<Eigen::Vector3f> points_;  // the points, in the same order (read contiguously)
 };
 
@@ -103,6 +109,8 @@ struct KernelConstants {
 };
 KernelConstants kernelConstants(double sigma, double color_ell, double color_sigma,
                                 double sparsification);
+
+constexpr int kLabelDim = int(Label::RowsAtCompileTime);
 
 // Moving points per chunk. Chunks are the unit of parallel work and of the reductions, which
 // run over them in a fixed order: results do not depend on the number of threads.
@@ -130,7 +138,12 @@ class CandidateLists {
     std::vector<float> color;  // sigma_c^2 exp(-|f_i - g_j|^2 / 2 l_c^2)
     std::vector<float> x, y, z;
     Eigen::ArrayXf scratch_d2, scratch_a;  // work buffers as long as the chunk's longest list
-    std::vector<int> near;  // build's work buffer: grid positions within reach of one point
+    // build's work buffers: a run's squared distances and label distances, and the grid
+    // positions of one point's candidates (within reach, colour not ruled out) with their label
+    // distances.
+    std::vector<float> run_d2, run_label_d2;
+    std::vector<int> near;
+    std::vector<float> near_label_d2;
   };
 
   // `grid` indexes the fixed cloud's points (any cell: queries cover their own radius).
@@ -157,7 +170,8 @@ class CandidateLists {
 
   const LabelledCloud& moving_;
   const VoxelGrid& grid_;
-  std::vector<Label> grid_labels_;  // the fixed labels in the grid's order (read contiguously)
+  // The fixed labels in the grid's order, one array per channel (read contiguously by runs).
+  std::array<std::vector<float>, kLabelDim> grid_labels_;
   KernelConstants k_;
   std::vector<float> search_scale_;
   std::vector<Chunk> chunks_;
