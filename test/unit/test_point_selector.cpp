@@ -262,6 +262,58 @@ TEST(PointSelector, DensePassCountEqualsThePassItCounts) {
   EXPECT_EQ(checked, 200u);
 }
 
+// Level 0 of the candidate maps against the header's definition, the block medians taken by
+// sorting: |grad I|^2 kept exactly where it is above the square of the mean over the 3x3
+// neighbouring blocks (those with pixels) of (median of floor(|grad I|), clamped to 48, plus 7).
+TEST(CandidateMaps, LevelZeroKeepsWhatTheBlockThresholdsDefine) {
+  constexpr int kBlock = 32, kMax = 48;
+  cv::Mat half_blank = texturedImage(200, 150, 7);
+  half_blank(cv::Rect(0, 0, 100, 70)).setTo(90);  // blocks of one grey value: median 0
+  for (const cv::Mat& gray : {texturedImage(640, 480, 3), texturedImage(97, 61, 4), half_blank}) {
+    const selection::CandidatePyramid pyr = selection::candidateMaps(gray);
+    const int bx = (gray.cols + kBlock - 1) / kBlock, by = (gray.rows + kBlock - 1) / kBlock;
+    std::vector<float> median(std::size_t(bx) * by);
+    for (int b = 0; b < by; ++b) {
+      for (int a = 0; a < bx; ++a) {
+        std::vector<int> bins;
+        for (int v = std::max(b * kBlock, 1); v < std::min((b + 1) * kBlock, gray.rows - 1); ++v) {
+          for (int u = std::max(a * kBlock, 1); u < std::min((a + 1) * kBlock, gray.cols - 1);
+               ++u) {
+            const double g = std::sqrt(double(selection::gradientMag2(gray, u, v)));
+            bins.push_back(std::min(int(std::floor(g)), kMax));
+          }
+        }
+        std::sort(bins.begin(), bins.end());
+        // A block without such pixels (a 97-pixel wide image's last column) has no median.
+        median[std::size_t(b) * bx + a] = bins.empty() ? NAN : float(bins[bins.size() / 2]);
+      }
+    }
+    int kept = 0;
+    for (int v = 1; v + 1 < gray.rows; ++v) {
+      for (int u = 1; u + 1 < gray.cols; ++u) {
+        const int a = u / kBlock, b = v / kBlock;
+        float sum = 0.0f;
+        int num = 0;
+        for (int nb = std::max(b - 1, 0); nb <= std::min(b + 1, by - 1); ++nb) {
+          for (int na = std::max(a - 1, 0); na <= std::min(a + 1, bx - 1); ++na) {
+            const float m = median[std::size_t(nb) * bx + na];
+            if (std::isnan(m)) continue;
+            sum += m + 7.0f;
+            ++num;
+          }
+        }
+        const float th = sum / float(num);
+        const float mag2 = selection::gradientMag2(gray, u, v);
+        const float want = mag2 > th * th ? mag2 : 0.0f;
+        ASSERT_EQ(pyr[0].at(u, v), want) << gray.size() << " at " << u << ", " << v;
+        kept += want > 0.0f;
+      }
+    }
+    EXPECT_GT(kept, gray.total() / 20) << gray.size();
+    EXPECT_LT(kept, gray.total() / 2) << gray.size();
+  }
+}
+
 TEST(PointSelector, BlankImageSelectsNothing) {
   const cv::Mat gray(120, 160, CV_8UC1, cv::Scalar(128));
   const Selection s = selectPixels(gray, constantDepth(gray.size(), 2.f), SelectionParams());

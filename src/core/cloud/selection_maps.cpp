@@ -1,7 +1,7 @@
 // Choices the method leaves open, made here: the block median is the value of rank floor(n/2)
 // among the block's n pixels that have central differences; the 3x3 smoothing averages the
-// neighbouring blocks that exist (fewer at the image edges); blocks at the right and bottom edges
-// may be partial.
+// neighbouring blocks that exist and have such pixels (fewer at the image edges); blocks at the
+// right and bottom edges may be partial.
 #include "selection_maps.hpp"
 
 #include <algorithm>
@@ -15,8 +15,6 @@ constexpr int kBlock = 32;          // side of the blocks the thresholds are com
 constexpr int kHistMax = 48;        // floor(|grad I|) is clamped to this in the histogram
 constexpr float kThresholdAdd = 7;  // added to the block median
 constexpr std::array<float, 3> kLevelFactor = {1.f, 0.75f, 0.75f * 0.5625f};
-
-using Histogram = std::array<int, kHistMax + 1>;
 
 // |grad I|^2 by central differences into `out` (same size), 0 on the outermost pixels.
 template <typename T>
@@ -52,10 +50,6 @@ std::vector<float> halve(const T* image, int width, int height) {
   return out;
 }
 
-int histogramBin(float mag2) {
-  return std::min(static_cast<int>(std::sqrt(mag2)), kHistMax);
-}
-
 // Smoothed block thresholds on |grad I| (not squared), row-major over the blocks.
 struct BlockThresholds {
   int blocks_x = 0;
@@ -63,70 +57,82 @@ struct BlockThresholds {
   float at(int bx, int by) const { return th[static_cast<std::size_t>(by) * blocks_x + bx]; }
 };
 
-// histogramBin(m) = binOfQuarters(floor(4 m)) for every m >= 0 (k^2 <= m if and only if
-// 4 k^2 <= floor(4 m)), by table up to the last bin's 4 * 48^2. Level-0 values are quarters of
-// integers anyway (central differences of 8-bit values).
-constexpr int kLastQuarters = 4 * kHistMax * kHistMax;
-const std::array<std::uint8_t, kLastQuarters + 1>& binOfQuarters() {
-  static const auto table = [] {
-    std::array<std::uint8_t, kLastQuarters + 1> t{};
-    for (int q = 0; q <= kLastQuarters; ++q) {
-      t[static_cast<std::size_t>(q)] = static_cast<std::uint8_t>(histogramBin(0.25f * q));
+// How many of a block's bins are at most b (bins of pixels without gradient are kNoBin): per
+// column of the block, in bytes (a block has at most kBlock rows), which vectorise.
+constexpr std::uint8_t kNoBin = 255;
+int countAtMost(const std::uint8_t* rows, int stride, int row_count, int u0, int u1,
+                std::uint8_t b) {
+  std::array<std::uint8_t, kBlock> per_column{};
+  const int width = u1 - u0;
+  for (int r = 0; r < row_count; ++r) {
+    const std::uint8_t* row = rows + static_cast<std::size_t>(r) * stride + u0;
+    for (int u = 0; u < width; ++u) {
+      per_column[std::size_t(u)] =
+          static_cast<std::uint8_t>(per_column[std::size_t(u)] + (row[u] <= b));
     }
-    return t;
-  }();
-  return table;
+  }
+  int count = 0;
+  for (const std::uint8_t c : per_column) count += c;
+  return count;
 }
 
 BlockThresholds blockThresholds(const CandidateLevel& mag2) {
-  const int bx = (mag2.width + kBlock - 1) / kBlock, by = (mag2.height + kBlock - 1) / kBlock;
-  std::vector<Histogram> hist(static_cast<std::size_t>(bx) * by, Histogram{});
-  // Per block row, four histograms per block that take the pixels in turn: neighbouring pixels
-  // mostly fall in the same bin, and with one histogram each increment waited on the one before
-  // (two thirds of the candidate maps' time went to that chain).
-  const auto& bin_of = binOfQuarters();
-  std::vector<std::array<Histogram, 4>> lanes(static_cast<std::size_t>(bx));
-  std::vector<int> quarters(static_cast<std::size_t>(mag2.width), 0);
+  const int w = mag2.width, h = mag2.height;
+  const int bx = (w + kBlock - 1) / kBlock, by = (h + kBlock - 1) / kBlock;
+  // Per block row, each pixel's bin floor(|grad I|), clamped to kHistMax, as a byte (the square
+  // root vectorised); then each block's median bin by bisection over [0, kHistMax], counting the
+  // bins at most the middle one a block at a time. A histogram per block took its scattered
+  // increments one by one: half the candidate maps' time.
+  std::vector<std::uint8_t> bins(static_cast<std::size_t>(kBlock) * w, kNoBin);
+  std::vector<float> root(static_cast<std::size_t>(w), 0.f);
+  std::vector<float> median(static_cast<std::size_t>(bx) * by, 0.f);
+  std::vector<std::uint8_t> has_pixels(median.size(), 0);
   for (int b = 0; b < by; ++b) {
-    for (auto& l : lanes) l.fill(Histogram{});
-    const int v_end = std::min((b + 1) * kBlock, mag2.height - 1);
-    for (int v = std::max(b * kBlock, 1); v < v_end; ++v) {
-      const float* row = &mag2.value[static_cast<std::size_t>(v) * mag2.width];
-      for (int u = 1; u + 1 < mag2.width; ++u) {
-        quarters[std::size_t(u)] = std::min(static_cast<int>(4.f * row[u]), kLastQuarters);
-      }
-      for (int u = 1; u + 1 < mag2.width; ++u) {
-        ++lanes[std::size_t(u / kBlock)][std::size_t(u & 3)]
-               [bin_of[std::size_t(quarters[std::size_t(u)])]];
-      }
-    }
-    for (int x = 0; x < bx; ++x) {
-      Histogram& h = hist[static_cast<std::size_t>(b) * bx + x];
-      for (const Histogram& l : lanes[std::size_t(x)]) {
-        for (std::size_t k = 0; k < h.size(); ++k) h[k] += l[k];
+    const int v0 = std::max(b * kBlock, 1), v1 = std::min((b + 1) * kBlock, h - 1);
+    if (v0 >= v1) continue;
+    for (int v = v0; v < v1; ++v) {
+      const float* row = &mag2.value[static_cast<std::size_t>(v) * w];
+      std::uint8_t* out = &bins[static_cast<std::size_t>(v - v0) * w];
+      for (int u = 1; u + 1 < w; ++u) root[std::size_t(u)] = std::sqrt(row[u]);
+      for (int u = 1; u + 1 < w; ++u) {
+        out[u] =
+            static_cast<std::uint8_t>(std::min(static_cast<int>(root[std::size_t(u)]), kHistMax));
       }
     }
+    for (int a = 0; a < bx; ++a) {
+      const int u0 = std::max(a * kBlock, 1), u1 = std::min((a + 1) * kBlock, w - 1);
+      if (u0 >= u1) continue;
+      const int half = (v1 - v0) * (u1 - u0) / 2;
+      // The first bin whose cumulative count exceeds half the block's pixels (kHistMax at most).
+      int lo = 0, hi = kHistMax;
+      while (lo < hi) {
+        const int mid = (lo + hi) / 2;
+        if (countAtMost(bins.data(), w, v1 - v0, u0, u1, std::uint8_t(mid)) > half) {
+          hi = mid;
+        } else {
+          lo = mid + 1;
+        }
+      }
+      median[static_cast<std::size_t>(b) * bx + a] = static_cast<float>(lo);
+      has_pixels[static_cast<std::size_t>(b) * bx + a] = 1;
+    }
   }
-  std::vector<float> median(hist.size());
-  for (std::size_t b = 0; b < hist.size(); ++b) {
-    int n = 0;
-    for (int c : hist[b]) n += c;
-    int bin = 0, below = 0;
-    while (bin < kHistMax && below + hist[b][bin] <= n / 2) below += hist[b][bin++];
-    median[b] = static_cast<float>(bin);
-  }
-  BlockThresholds out{bx, std::vector<float>(hist.size())};
+  // The mean over the 3x3 neighbouring blocks that have pixels (a block at the right or bottom
+  // edge may hold only the outermost pixels, which have no gradient).
+  BlockThresholds out{bx, std::vector<float>(median.size(), 0.f)};
   for (int y = 0; y < by; ++y) {
     for (int x = 0; x < bx; ++x) {
       float sum = 0.f;
       int num = 0;
       for (int ny = std::max(y - 1, 0); ny <= std::min(y + 1, by - 1); ++ny) {
         for (int nx = std::max(x - 1, 0); nx <= std::min(x + 1, bx - 1); ++nx) {
-          sum += median[static_cast<std::size_t>(ny) * bx + nx] + kThresholdAdd;
+          const std::size_t k = static_cast<std::size_t>(ny) * bx + nx;
+          if (!has_pixels[k]) continue;
+          sum += median[k] + kThresholdAdd;
           ++num;
         }
       }
-      out.th[static_cast<std::size_t>(y) * bx + x] = sum / static_cast<float>(num);
+      out.th[static_cast<std::size_t>(y) * bx + x] = num > 0 ? sum / static_cast<float>(num) : 0.f;
     }
   }
   return out;

@@ -21,9 +21,9 @@ struct CandidateLevel {
 using CandidatePyramid = std::array<CandidateLevel, 3>;
 
 // gray: CV_8UC1. Thresholds: per 32x32 block, the median of floor(|grad I|) (clamped to 48)
-// plus 7, averaged over the 3x3 neighbouring blocks, squared; level 1 uses 0.75 of it and
-// level 2 0.75 * 0.5625. Gradients are central differences of each level; the outermost pixels
-// of each level have none (value 0).
+// plus 7, averaged over the 3x3 neighbouring blocks that have gradients, squared; level 1 uses
+// 0.75 of it and level 2 0.75 * 0.5625. Gradients are central differences of each level; the
+// outermost pixels of each level have none (value 0).
 CandidatePyramid candidateMaps(const cv::Mat& gray);
 
 // Picks of the selector's pass with cells of `pot` pixels over `gray` (point_selector.cpp), and
