@@ -672,14 +672,35 @@ DirectSums densePlaneSums(const DirectImages& reference, const DirectImages& mov
   const cv::Mat& S = reference.point_sums;
   constexpr int w = kGridWindow, r = kNormalReach, margin = kGridWindow + kNormalReach + 1;
   constexpr double half = 0.5 * (2 * w + 1) * (2 * w + 1);
-  std::vector<Residual> residuals;
-  residuals.reserve(grid.points.size());
+  // Where the grid's points land, then their planes, each with the pixels of the one kAhead on
+  // asked for (the window sums are 16 bytes a pixel: 4.9 MB at 640x480).
+  struct GridLanding {
+    Eigen::Vector3d y;
+    int u, v;
+  };
+  std::vector<GridLanding> landed;
+  landed.reserve(grid.points.size());
   for (const Eigen::Vector3d& p : grid.points) {
     const Eigen::Vector3d y = T * p;
     if (!(y.z() > 0.0)) continue;
     const int u = int(std::lround(cam.fx * y.x() / y.z() + cam.cx));
     const int v = int(std::lround(cam.fy * y.y() / y.z() + cam.cy));
     if (u < margin || v < margin || u + margin >= D.cols || v + margin >= D.rows) continue;
+    landed.push_back({y, u, v});
+  }
+  std::vector<Residual> residuals;
+  residuals.reserve(landed.size());
+  for (std::size_t k = 0; k < landed.size(); ++k) {
+    if (k + kAhead < landed.size()) {
+      const GridLanding& next = landed[k + kAhead];
+      for (const cv::Point d : {cv::Point(0, 0), cv::Point(-r, 0), cv::Point(r, 0),
+                                cv::Point(0, -r), cv::Point(0, r)}) {
+        __builtin_prefetch(&D.at<float>(next.v + d.y, next.u + d.x));
+        __builtin_prefetch(&S.at<cv::Vec4f>(next.v + d.y, next.u + d.x));
+      }
+    }
+    const Eigen::Vector3d& y = landed[k].y;
+    const int u = landed[k].u, v = landed[k].v;
     const float z = D.at<float>(v, u);
     // Not occluded; the pixels the plane is taken from all on the same surface.
     if (!sameSurface(z, float(y.z())) || !sameSurface(D.at<float>(v, u - r), z) ||
