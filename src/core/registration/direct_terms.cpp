@@ -407,26 +407,40 @@ void addReferenceImages(DirectImages& images, const LabelledCloud& cloud) {
                 cv::BORDER_CONSTANT);
 }
 
-std::vector<Landing> landings(const DirectImages& reference, const DirectImages& moving_images,
-                              const LabelledCloud& moving, const Eigen::Isometry3d& T) {
+namespace {
+
+// The points (those marked in `usable`) placed by T that land in front of the camera and inside
+// `image` one pixel in (for the bilinear sample and its derivatives), in the points' order.
+std::vector<Landing> landingsInside(const std::vector<Eigen::Vector3f>& points,
+                                    const std::vector<std::uint8_t>& usable,
+                                    const Eigen::Isometry3d& T, const Camera& cam,
+                                    const cv::Mat& image) {
   std::vector<Landing> out;
-  if (!reference.isReference() || moving_images.empty() ||
-      moving_images.one_surface.size() != moving.size()) {
-    return out;
-  }
-  out.reserve(moving.size());
-  const Camera& cam = reference.camera;
-  const cv::Mat& D = reference.depth;
+  out.reserve(points.size());
   Landing l;
-  for (l.j = 0; l.j < moving.size(); ++l.j) {
-    if (!moving_images.one_surface[l.j]) continue;
-    l.y = T * moving.points[l.j].cast<double>();
+  for (l.j = 0; l.j < points.size(); ++l.j) {
+    if (!usable[l.j]) continue;
+    l.y = T * points[l.j].cast<double>();
     if (!(l.y.z() > 0.0)) continue;
     l.u = cam.fx * l.y.x() / l.y.z() + cam.cx;
     l.v = cam.fy * l.y.y() / l.y.z() + cam.cy;
-    if (!(l.u >= 1.0 && l.v >= 1.0 && l.u < D.cols - 2.0 && l.v < D.rows - 2.0)) continue;
+    if (!(l.u >= 1.0 && l.v >= 1.0 && l.u < image.cols - 2.0 && l.v < image.rows - 2.0)) continue;
     out.push_back(l);
   }
+  return out;
+}
+
+}  // namespace
+
+std::vector<Landing> landings(const DirectImages& reference, const DirectImages& moving_images,
+                              const LabelledCloud& moving, const Eigen::Isometry3d& T) {
+  if (!reference.isReference() || moving_images.empty() ||
+      moving_images.one_surface.size() != moving.size()) {
+    return {};
+  }
+  const cv::Mat& D = reference.depth;
+  std::vector<Landing> out =
+      landingsInside(moving.points, moving_images.one_surface, T, reference.camera, D);
   // Not occluded: the reference's depth there, read with the pixel kAhead on asked for.
   std::size_t kept = 0;
   for (std::size_t k = 0; k < out.size(); ++k) {
@@ -548,18 +562,8 @@ DirectSums reversePhotometricSums(const DirectImages& reference,
   const Eigen::Matrix3d R = T.linear();
   // Where the reference's points land in the moving image (as Landing: j the reference point),
   // then their samples, each with the rows of the one kAhead on asked for.
-  std::vector<Landing> landed;
-  landed.reserve(n);
-  Landing l;
-  for (l.j = 0; l.j < n; ++l.j) {
-    if (!reference.one_surface[l.j]) continue;
-    l.y = to_moving * reference_cloud.points[l.j].cast<double>();
-    if (!(l.y.z() > 0.0)) continue;
-    l.u = cam.fx * l.y.x() / l.y.z() + cam.cx;
-    l.v = cam.fy * l.y.y() / l.y.z() + cam.cy;
-    if (!(l.u >= 1.0 && l.v >= 1.0 && l.u < D.cols - 2.0 && l.v < D.rows - 2.0)) continue;
-    landed.push_back(l);
-  }
+  const std::vector<Landing> landed =
+      landingsInside(reference_cloud.points, reference.one_surface, to_moving, cam, D);
   std::vector<Residual> residuals;
   residuals.reserve(landed.size());
   for (std::size_t k = 0; k < landed.size(); ++k) {
