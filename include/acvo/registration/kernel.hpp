@@ -72,12 +72,11 @@ class VoxelGrid {
   template <typename F>
   void forEachWithin(const Eigen::Vector3f& q, float radius, F&& f) const;
   // The same box as runs of the grid's order: f(begin, end) for each column the box covers that
-  // has points in its z range, in the order forEachWithin visits them; index(k) and point(k)
-  // give the k-th point of that order.
+  // has points in its z range, in the order forEachWithin visits them; index(k) and xs()[k],
+  // ys()[k], zs()[k] give the k-th point of that order.
   template <typename F>
   void forEachRun(const Eigen::Vector3f& q, float radius, F&& f) const;
   int index(int k) const { return order_[std::size_t(k)]; }
-  const Eigen::Vector3f& point(int k) const { return points_[std::size_t(k)]; }
   // The points' coordinates in the same order, one array each (for loops over a run that the
   // compiler vectorises).
   const float* xs() const { return x_.data(); }
@@ -96,8 +95,7 @@ class VoxelGrid {
   int nx_ = 0, ny_ = 0;
   std::vector<int> column_start_;  // size nx*ny + 1
   std::vector<int> order_;         // point indices by column, by z within a column
-  std::vector<float> x_, y_, z_;   // their coordinates, in the same order
-  std::vector<Eigen::Vector3f> points_;  // the points, in the same order (read contiguously)
+  std::vector<float> x_, y_, z_;   // their coordinates, in the same order (read contiguously)
 };
 
 // The kernel's constants as the per-pair loops use them.
@@ -190,7 +188,10 @@ LabelledCloud stridedSubset(const LabelledCloud& cloud, int count);
 template <typename F>
 void VoxelGrid::forEachWithin(const Eigen::Vector3f& q, float radius, F&& f) const {
   forEachRun(q, radius, [&](int begin, int end) {
-    for (int k = begin; k < end; ++k) f(order_[std::size_t(k)], points_[std::size_t(k)]);
+    for (int k = begin; k < end; ++k) {
+      const auto i = std::size_t(k);
+      f(order_[i], Eigen::Vector3f(x_[i], y_[i], z_[i]));
+    }
   });
 }
 

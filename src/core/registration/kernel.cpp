@@ -101,12 +101,11 @@ VoxelGrid::VoxelGrid(const std::vector<Eigen::Vector3f>& points, float cell) : c
       });
     }
   }
-  points_.resize(order_.size());
   for (std::size_t k = 0; k < order_.size(); ++k) {
-    points_[k] = points[std::size_t(order_[k])];
-    x_[k] = points_[k].x();
-    y_[k] = points_[k].y();
-    z_[k] = points_[k].z();
+    const Eigen::Vector3f& p = points[std::size_t(order_[k])];
+    x_[k] = p.x();
+    y_[k] = p.y();
+    z_[k] = p.z();
   }
 }
 
