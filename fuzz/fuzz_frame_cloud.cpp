@@ -125,7 +125,6 @@ Decoded decode(const std::uint8_t* data, std::size_t size) {
   d.params.selection.target_points = 20 + in.byte();
   // Fewer iterations than the defaults keep a run short; every exit of the loops stays reachable.
   d.params.paper.max_iterations = 30;
-  d.params.paper.coarse_iterations = 5;
   d.params.odometry.threads = 1;
 
   acvo::Camera& cam = d.frame.camera;

@@ -15,7 +15,6 @@ enum class Engine { kCoarseToFine, kPaper };
 enum class EllPolicy { kAdaptive, kFixedSchedule };
 enum class EllUpdate { kDescent, kReference };
 enum class InitialGuess { kConstantVelocity, kIdentity };
-enum class SearchDirection { kConjugateGradient, kGradient };
 enum class Reference { kKeyframe, kPreviousFrame };
 
 struct SelectionParams {
@@ -114,8 +113,6 @@ struct PaperParams {
   // adaptive: descent (as the paper states) or reference (as the authors' code: ascent, the
   // moving cloud's self-kernel rows below the fixed cloud's size left out of the sum).
   EllUpdate ell_update = EllUpdate::kReference;
-  // The gradient (the paper) or nonlinear conjugate gradient (Polak-Ribiere+, not in the paper).
-  SearchDirection direction = SearchDirection::kGradient;
   double ell_init = 0.1;      // m, initial spatial length-scale (reset per frame)
   double ell_min = 0.0391;    // m
   double ell_max = 0.15;      // m (only shrinks within a frame, reset per frame)
@@ -133,14 +130,6 @@ struct PaperParams {
   double omega_scale = 7.0;     // c: omega = (1/c) sum a (x cross y)
   double v_scale = 7.0;         // d: v = (1/d) sum a (y - x)
   int max_iterations = 2000;    // as the authors' code
-  // Stop when F has not improved for this many iterations at an unchanged length-scale and
-  // return the best transform seen (not in the paper). 0 = off.
-  int stall_iterations = 0;
-  // Coarse stage (not in the paper): a few iterations at a wide fixed length-scale on a subset
-  // of the moving points before the main ones. 0 = off.
-  double coarse_ell = 0.0;     // m
-  int coarse_points = 500;     // moving points used by the coarse stage (evenly strided)
-  int coarse_iterations = 20;  // iteration cap of the coarse stage
   // fixed_schedule: the schedule's first stage (iterations 0-3) at the previous registration's
   // final length-scale instead of 0.15, as the authors' CVO code runs (its length-scale outlives
   // the frame). The engine then keeps that length-scale between registrations.
@@ -230,14 +219,12 @@ std::string toString(Engine v);
 std::string toString(EllPolicy v);
 std::string toString(EllUpdate v);
 std::string toString(InitialGuess v);
-std::string toString(SearchDirection v);
 std::string toString(Reference v);
 // Throw std::invalid_argument listing the accepted values.
 void fromString(const std::string& s, Engine& v);
 void fromString(const std::string& s, EllPolicy& v);
 void fromString(const std::string& s, EllUpdate& v);
 void fromString(const std::string& s, InitialGuess& v);
-void fromString(const std::string& s, SearchDirection& v);
 void fromString(const std::string& s, Reference& v);
 
 // Calls visit(section, name, field) for every parameter; field is int&, double&, bool& or one
@@ -278,7 +265,6 @@ void visitParams(Params_& p, Visitor&& visit) {
   auto& a = p.paper;
   visit("paper", "ell_policy", a.ell_policy);
   visit("paper", "ell_update", a.ell_update);
-  visit("paper", "direction", a.direction);
   visit("paper", "ell_init", a.ell_init);
   visit("paper", "ell_min", a.ell_min);
   visit("paper", "ell_max", a.ell_max);
@@ -295,10 +281,6 @@ void visitParams(Params_& p, Visitor&& visit) {
   visit("paper", "omega_scale", a.omega_scale);
   visit("paper", "v_scale", a.v_scale);
   visit("paper", "max_iterations", a.max_iterations);
-  visit("paper", "stall_iterations", a.stall_iterations);
-  visit("paper", "coarse_ell", a.coarse_ell);
-  visit("paper", "coarse_points", a.coarse_points);
-  visit("paper", "coarse_iterations", a.coarse_iterations);
   visit("paper", "carry_ell", a.carry_ell);
   visit("paper", "min_points", a.min_points);
   visit("paper", "hard_ell_reductions", a.hard_ell_reductions);

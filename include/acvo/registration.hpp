@@ -52,8 +52,6 @@ struct SolverResult {
   // odometry judges such a frame hard to track.
   std::string hard;
   // The paper engine's own diagnostics (zero for coarse_to_fine).
-  int coarse_iterations = 0;     // coarse-stage iterations
-  bool stalled = false;          // stopped by the stall rule (the best iterate is returned)
   bool ell_at_bound = false;     // final ell pinned at ell_min or at the (shrunk) ell_max
   int ell_bound_iterations = 0;  // iterations that ended with ell pinned at a bound
   int ell_max_reductions = 0;    // times ell reached ell_max and the bound shrank

@@ -41,13 +41,6 @@ struct EnumNames<InitialGuess> {
 };
 
 template <>
-struct EnumNames<SearchDirection> {
-  static constexpr std::pair<SearchDirection, const char*> table[] = {
-      {SearchDirection::kConjugateGradient, "conjugate_gradient"},
-      {SearchDirection::kGradient, "gradient"}};
-};
-
-template <>
 struct EnumNames<Reference> {
   static constexpr std::pair<Reference, const char*> table[] = {
       {Reference::kKeyframe, "keyframe"}, {Reference::kPreviousFrame, "previous_frame"}};
@@ -128,9 +121,6 @@ std::string toString(EllUpdate v) {
 std::string toString(InitialGuess v) {
   return enumToString(v);
 }
-std::string toString(SearchDirection v) {
-  return enumToString(v);
-}
 std::string toString(Reference v) {
   return enumToString(v);
 }
@@ -144,9 +134,6 @@ void fromString(const std::string& s, EllUpdate& v) {
   enumFromString(s, v);
 }
 void fromString(const std::string& s, InitialGuess& v) {
-  enumFromString(s, v);
-}
-void fromString(const std::string& s, SearchDirection& v) {
   enumFromString(s, v);
 }
 void fromString(const std::string& s, Reference& v) {
@@ -203,10 +190,6 @@ std::string validate(const Params& p) {
   check(why, a.omega_scale > 0.0, "paper.omega_scale", "must be positive");
   check(why, a.v_scale > 0.0, "paper.v_scale", "must be positive");
   check(why, a.max_iterations > 0, "paper.max_iterations", "must be positive");
-  check(why, a.stall_iterations >= 0, "paper.stall_iterations", "must not be negative");
-  check(why, a.coarse_ell >= 0.0, "paper.coarse_ell", "must not be negative (0 = off)");
-  check(why, a.coarse_points > 0, "paper.coarse_points", "must be positive");
-  check(why, a.coarse_iterations >= 0, "paper.coarse_iterations", "must not be negative");
   check(why, a.min_points > 0, "paper.min_points", "must be positive");
   check(why, a.hard_ell_reductions > 0, "paper.hard_ell_reductions", "must be positive");
   check(why, a.covariance_scale > 0.0, "paper.covariance_scale", "must be positive");

@@ -153,30 +153,6 @@ TEST(LengthScale, GradientMatchesCentralDifferenceOfJ) {
   }
 }
 
-// ---- search direction
-// ----------------------------------------------------------------------------
-TEST(ConjugateDirection, PolakRibierePlusWithRestarts) {
-  const Vector6d g0 = (Vector6d() << 1, 0, 0, 0, 0, 0).finished();
-  const Vector6d g1 = (Vector6d() << 0.5, 0.5, 0, 0, 0, 0).finished();
-  // beta = g1.(g1 - g0) / |g0|^2 = (0.25 + 0.25 - 0.5) / 1 = 0 -> g1 itself.
-  EXPECT_TRUE(conjugateDirection(g1, g0, g0).isApprox(g1, 1e-15));
-  // beta = g2.(g2 - g0) / |g0|^2 = 0.5 with g2 = (0, 1, 0.5, ...): d = g2 + 0.5 d_prev.
-  const Vector6d g2 = (Vector6d() << 0, 0.5, 0.5, 0, 0, 0).finished();
-  const Vector6d d_prev = (Vector6d() << 0, 0, 2, 0, 0, 0).finished();
-  EXPECT_TRUE(conjugateDirection(g2, g0, d_prev)
-                  .isApprox((Vector6d() << 0, 0.5, 1.5, 0, 0, 0).finished(), 1e-15));
-  // Negative beta is clipped to 0 (the "+"): g4 = 0.1 g0 gives beta = 0.1 (0.1 - 1) < 0 -> g4.
-  const Vector6d g4 = 0.1 * g0;
-  EXPECT_TRUE(conjugateDirection(g4, g0, d_prev).isApprox(g4, 1e-15));
-  // A combination that would descend (d.g <= 0) restarts from the gradient.
-  const Vector6d g5 = (Vector6d() << 0, 0, -1, 0, 0, 0).finished();
-  const Vector6d g5_prev = (Vector6d() << 0, 0, 0.1, 0, 0, 0).finished();  // beta = 110
-  const Vector6d up = (Vector6d() << 0, 0, 1, 0, 0, 0).finished();
-  EXPECT_TRUE(conjugateDirection(g5, g5_prev, up).isApprox(g5, 1e-15));
-  // Nothing to build on: a zero previous gradient.
-  EXPECT_TRUE(conjugateDirection(g1, Vector6d::Zero(), d_prev).isApprox(g1, 1e-15));
-}
-
 // ---- whole registrations ------------------------------------------------------------------------
 // Linear convergence taken at once: aligned steps shrinking by rho are extended by 1/(1-rho),
 // rho capped; anything else is left as Gauss-Newton gave it.
@@ -236,42 +212,6 @@ TEST(LengthScale, GradientIsNormalisedByThePairsThatEnterIt) {
   EXPECT_DOUBLE_EQ(lengthScaleGradient(xx, yy, xy, 0.5, EllUpdate::kReference), 3.0 / 0.125);
 }
 
-TEST(StallRule, StopsAfterPatienceIterationsWithoutABetterObjectiveAtOneLengthScale) {
-  StallTracker stall(3);
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  auto at = [&](double x) {
-    T.translation().x() = x;
-    return T;
-  };
-  EXPECT_FALSE(stall.stalls(0.1, 5.0, at(0.0)));
-  EXPECT_FALSE(stall.stalls(0.1, 6.0, at(1.0)));  // best so far
-  EXPECT_FALSE(stall.stalls(0.1, 5.5, at(2.0)));
-  EXPECT_FALSE(stall.stalls(0.1, 5.9, at(3.0)));
-  EXPECT_TRUE(stall.stalls(0.1, 4.0, at(4.0)));
-  EXPECT_EQ(stall.best().translation().x(), 1.0);
-  // A new length-scale starts the count again.
-  StallTracker fresh(2);
-  EXPECT_FALSE(fresh.stalls(0.1, 5.0, at(0.0)));
-  EXPECT_FALSE(fresh.stalls(0.1, 4.0, at(1.0)));
-  EXPECT_FALSE(fresh.stalls(0.05, 3.0, at(2.0)));
-  EXPECT_FALSE(fresh.stalls(0.05, 2.0, at(3.0)));
-  EXPECT_TRUE(fresh.stalls(0.05, 1.0, at(4.0)));
-  EXPECT_EQ(fresh.best().translation().x(), 2.0);
-  StallTracker off(0);
-  for (int k = 0; k < 10; ++k) EXPECT_FALSE(off.stalls(0.1, 1.0, at(k)));
-}
-
-TEST(SearchState, GradientFirstThenConjugate) {
-  Vector6d g1, g2;
-  g1 << 1, 0, 0, 0, 1, 0;
-  g2 << 0.5, 0.5, 0, 0, 0.5, 0;
-  SearchState cg, plain;
-  EXPECT_EQ(cg.next(g1, SearchDirection::kConjugateGradient), g1);
-  EXPECT_EQ(cg.next(g2, SearchDirection::kConjugateGradient), conjugateDirection(g2, g1, g1));
-  EXPECT_EQ(plain.next(g1, SearchDirection::kGradient), g1);
-  EXPECT_EQ(plain.next(g2, SearchDirection::kGradient), g2);
-}
-
 TEST(Align, IdenticalCloudsGiveIdentityInZeroIterations) {
   PaperParams p = paperParams().paper;
   const LabelledCloud X = test::randomCloud(1500, 21, 0.5f);
@@ -312,34 +252,6 @@ TEST(Align, RecoversSmallMotionsOfARandomSurfaceCloud) {
       EXPECT_LT(err.head<3>().norm() * 180 / M_PI, 0.1) << "policy " << int(policy);
     }
   }
-}
-
-TEST(Align, ConjugateGradientReachesTheSameOptimumInFewerIterations) {
-  // A motion along which the objective is a long, narrow valley: translation along a plane-like
-  // slab of points (the random cloud's surface is thin in z) plus a rotation about its normal.
-  const Vector6d m = (Vector6d() << 0.0, 0.0, 0.04, 0.04, -0.03, 0.0).finished();
-  const Eigen::Isometry3d truth = expSE3(m);
-  PaperParams p = paperParams().paper;
-  p.max_iterations = 500;
-  const LabelledCloud X = test::randomCloud(3000, 41, 0.6f);
-  const LabelledCloud Z = test::transformed(X, truth.inverse());
-  const auto fx = preparePaper(X, p, true), mz = preparePaper(Z, p, false);
-  p.direction = SearchDirection::kGradient;
-  const SolverResult grad = alignPaper(*fx, *mz, Eigen::Isometry3d::Identity(), p);
-  p.direction = SearchDirection::kConjugateGradient;
-  const SolverResult cg = alignPaper(*fx, *mz, Eigen::Isometry3d::Identity(), p);
-  ASSERT_EQ(grad.status, SolverStatus::kConverged);
-  ASSERT_EQ(cg.status, SolverStatus::kConverged);
-  for (const SolverResult* r : {&grad, &cg}) {
-    const Vector6d err = logSE3(truth.inverse() * r->transform);
-    EXPECT_LT(err.tail<3>().norm(), 1e-3) << r->iterations << " iterations";
-    EXPECT_LT(err.head<3>().norm() * 180 / M_PI, 0.1) << r->iterations << " iterations";
-  }
-  std::cout << "iterations: conjugate gradient " << cg.iterations << ", gradient "
-            << grad.iterations << "\n";
-  // Measured: 18 against 306 iterations.
-  EXPECT_LT(cg.iterations, grad.iterations * 2 / 3)
-      << "conjugate gradient " << cg.iterations << ", gradient " << grad.iterations;
 }
 
 TEST(Align, LengthScaleStaysWithinBoundsAndEllMaxOnlyShrinks) {

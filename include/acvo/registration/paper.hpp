@@ -20,22 +20,6 @@ namespace acvo {
 // there is none; capped at max_step. Double precision, degenerate leading terms handled.
 double solveStep(double B, double C, double D, double E, double min_step, double max_step);
 
-// Search direction of a conjugate-gradient iteration (Polak-Ribiere+) from the gradient g, the
-// previous gradient and the previous direction; always an ascent direction (d.g > 0), g itself
-// when the previous iteration gives nothing to build on.
-Vector6d conjugateDirection(const Vector6d& g, const Vector6d& g_prev, const Vector6d& d_prev);
-
-// The direction of each iteration from its gradient: the gradient itself, or conjugate
-// gradient (conjugateDirection) from the second iteration on.
-class SearchState {
- public:
-  Vector6d next(const Vector6d& gradient, SearchDirection kind);
-
- private:
-  bool started_ = false;
-  Vector6d g_prev_ = Vector6d::Zero(), d_prev_ = Vector6d::Zero();
-};
-
 // The adaptive length-scale of one registration: ell and its upper bound, reset per frame;
 // `reductions` counts the times ell reached the bound and it shrank.
 struct LengthScale {
@@ -57,29 +41,12 @@ double lengthScaleGradient(const SelfSums& xx, const SelfSums& yy, const CrossSu
 // ends pinned at a bound.
 bool updateLengthScale(LengthScale& ls, double gradient, const PaperParams& p);
 
-// The stall rule (PaperParams::stall_iterations): remembers the best objective seen at the
-// current length-scale; stalls() says when `patience` iterations in a row at that length-scale
-// brought nothing better (best() is then the transform to keep). Never stalls for patience 0.
-class StallTracker {
- public:
-  explicit StallTracker(int patience) : patience_(patience) {}
-  bool stalls(double ell, double F, const Eigen::Isometry3d& T);
-  const Eigen::Isometry3d& best() const { return best_T_; }
-
- private:
-  int patience_;
-  double ell_ = -1.0, best_F_ = -INFINITY;
-  Eigen::Isometry3d best_T_ = Eigen::Isometry3d::Identity();
-  int since_best_ = 0;
-};
-
 // The length-scale of a fixed-schedule iteration, as the authors' CVO code switches it: 0.15
 // for iterations 0-3, 0.10 for 4-10, 0.06 for 11-20, 0.03 from 21 on.
 double scheduledEll(int iteration);
 
 std::shared_ptr<PaperCloud> preparePaper(LabelledCloud cloud, const PaperParams& p,
                                          bool as_reference);
-double preparePaperReference(PaperCloud& cloud, const PaperParams& p);
 // `carried_ell` > 0: the fixed schedule's first stage runs at it (PaperParams::carry_ell).
 SolverResult alignPaper(const PaperCloud& fixed, const PaperCloud& moving,
                         const Eigen::Isometry3d& guess, const PaperParams& p,

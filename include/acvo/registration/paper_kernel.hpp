@@ -27,11 +27,10 @@ struct SelfPair {
 };
 
 // A cloud as the paper engine prepares it: its search grid and self-kernel pairs, once per
-// frame (the self-kernel of frame k is the fixed self-kernel of frame k+1); a reference also
-// gets the coarse stage's grid.
+// frame (the self-kernel of frame k is the fixed self-kernel of frame k+1); a reference needs
+// nothing more.
 struct PaperCloud : PreparedCloud {
   VoxelGrid grid;         // cell = the search radius at the largest length-scale
-  VoxelGrid coarse_grid;  // cell = the search radius at the coarse stage's length-scale
   std::vector<SelfPair> self_pairs;  // all pairs within that radius that can pass the threshold
   // The same pairs' d2 and colour factors as arrays, for vectorised sums per iteration.
   Eigen::ArrayXf self_d2, self_color;

@@ -70,17 +70,6 @@ double smallestPositiveCubic(double A3, double A2, double A1, double A0) {
 
 }  // namespace
 
-Vector6d conjugateDirection(const Vector6d& g, const Vector6d& g_prev, const Vector6d& d_prev) {
-  const double g_prev2 = g_prev.squaredNorm();
-  if (!(g_prev2 > 0.0)) return g;
-  // Polak-Ribiere with the "+" restart: beta drops to 0 (plain gradient) when the gradient has
-  // turned so far that the previous direction no longer helps, e.g. after the length-scale moved.
-  const double beta = std::max(0.0, g.dot(g - g_prev) / g_prev2);
-  const Vector6d d = g + beta * d_prev;
-  // The line search only moves forward: a direction that does not ascend restarts from g.
-  return d.dot(g) > 0.0 && d.allFinite() ? d : g;
-}
-
 double solveStep(double B, double C, double D, double E, double min_step, double max_step) {
   double t = smallestPositiveCubic(4.0 * E, 3.0 * D, 2.0 * C, B);
   if (!std::isfinite(t)) t = min_step;
@@ -113,34 +102,6 @@ bool updateLengthScale(LengthScale& ls, double gradient, const PaperParams& p) {
   }
   ls.ell = std::max(ls.ell, p.ell_min);
   return ls.pinned(p);
-}
-
-bool StallTracker::stalls(double ell, double F, const Eigen::Isometry3d& T) {
-  if (patience_ <= 0) return false;
-  if (ell != ell_) {
-    ell_ = ell;
-    best_F_ = F;
-    best_T_ = T;
-    since_best_ = 0;
-  } else if (F > best_F_) {
-    best_F_ = F;
-    best_T_ = T;
-    since_best_ = 0;
-  } else if (++since_best_ >= patience_) {
-    return true;
-  }
-  return false;
-}
-
-Vector6d SearchState::next(const Vector6d& g, SearchDirection kind) {
-  const bool first = !started_;
-  started_ = true;
-  Vector6d d = kind == SearchDirection::kConjugateGradient && !first
-                   ? conjugateDirection(g, g_prev_, d_prev_)
-                   : g;
-  g_prev_ = g;
-  d_prev_ = d;
-  return d;
 }
 
 double scheduledEll(int iteration) {
