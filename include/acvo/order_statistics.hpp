@@ -19,10 +19,6 @@ namespace acvo {
 // std::nth_element(first, first + k, last) puts at first + k). Reorders the range.
 double kthSmallest(double* first, double* last, std::size_t k);
 
-// The upper median of values (the one at size / 2 once sorted); reorders them, which must not
-// be empty.
-double upperMedian(std::vector<double>& values);
-
 // The smallest value v of the (value, weight) pairs whose weights up to v reach half of all (a
 // sort's answer in linear time). Reorders the pairs, which must not be empty; no NaN, weights
 // not negative. The terms' learned scales are weighted medians.

@@ -67,9 +67,6 @@ struct SolverResult {
   // the depth's noise does not average away or its stamp is not the colour's; NaN where the
   // term is not part of the engine or is turned off).
   double dense_weight = std::numeric_limits<double>::quiet_NaN();
-  // ... and the variance of an edge's position (px^2) its residuals said at the last iteration
-  // (edgePositionVariance; NaN without the term or with too few residuals).
-  double edge_position2 = std::numeric_limits<double>::quiet_NaN();
   std::vector<IterationTrace> trace;
   // Time per stage, milliseconds.
   double ms_total = 0.0;

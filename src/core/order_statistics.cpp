@@ -51,10 +51,6 @@ double kthSmallest(double* first, double* last, std::size_t k) {
   return first[k];
 }
 
-double upperMedian(std::vector<double>& values) {
-  return kthSmallest(values.data(), values.data() + values.size(), values.size() / 2);
-}
-
 double weightedMedian(std::vector<std::pair<double, double>>& pairs) {
   double total = 0.0;
   for (const auto& p : pairs) total += p.second;

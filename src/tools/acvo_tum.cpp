@@ -135,7 +135,7 @@ int main(int argc, char** argv) {
                "neighbours,ms_step,ms_ell,"
                "ms_registration,ms_frame,rss_kib,keyframe,new_keyframe,depth_delay_ms,"
                "depth_moved,own_velocity_weight_rot,own_velocity_weight_trans,brightness_gain,"
-               "vignetting,dense_weight,second_start,edge_position2\n";
+               "vignetting,dense_weight,second_start\n";
     }
 
     acvo::Odometry odometry(params);
@@ -195,7 +195,7 @@ int main(int argc, char** argv) {
               << (r.depth_retimed ? 2 : int(r.depth_synced)) << ',' << r.own_velocity_weight[0]
               << ',' << r.own_velocity_weight[1] << ',' << s.brightness_gain << ',' << s.vignetting
               << ',' << s.dense_weight << ','
-              << (r.second_start_kept ? 2 : int(r.second_start)) << ',' << s.edge_position2
+              << (r.second_start_kept ? 2 : int(r.second_start))
               << '\n';
       }
       if (progress) {

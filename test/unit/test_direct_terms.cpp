@@ -104,87 +104,6 @@ Eigen::Isometry3d iterate(Sums&& sums, int iterations, int min_used = 500) {
   return T;
 }
 
-// Residuals r = n_grey + |grad I| n_position, grey noise of 2 levels and an edge position of
-// variance p2, gradients uniform in [0, 40] levels per pixel: the fit through the two halves
-// finds p2 (measured over 200 draws: 0.290 +- 0.019 for 0.3, 0.0791 for 1/12, 0.0000 for 0;
-// with a tenth of the residuals replaced by outliers in [-100, 100], 0.355 for 0.3).
-TEST(DirectTerms, TheEdgePositionIsFittedFromTheResidualsHalves) {
-  auto draw = [](double p2, double outliers, std::size_t n, unsigned seed) {
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<double> gradient(0.0, 40.0), outlier(-100.0, 100.0), u(0.0, 1.0);
-    std::normal_distribution<double> normal(0.0, 1.0);
-    std::vector<std::pair<double, double>> v;
-    for (std::size_t k = 0; k < n; ++k) {
-      const double g = gradient(rng);
-      double r = 2.0 * normal(rng) + g * std::sqrt(p2) * normal(rng);
-      if (u(rng) < outliers) r = outlier(rng);
-      v.emplace_back(r, g * g);
-    }
-    return v;
-  };
-  EXPECT_NEAR(edgePositionVariance(draw(0.3, 0.0, 3000, 1)), 0.3, 0.05);
-  EXPECT_NEAR(edgePositionVariance(draw(1.0 / 12.0, 0.0, 3000, 2)), 1.0 / 12.0, 0.02);
-  EXPECT_NEAR(edgePositionVariance(draw(0.0, 0.0, 3000, 3)), 0.0, 0.003);
-  const double with_outliers = edgePositionVariance(draw(0.3, 0.1, 3000, 4));
-  EXPECT_GT(with_outliers, 0.25);
-  EXPECT_LT(with_outliers, 0.45);
-  // Too few to tell, or no gradient to tell the halves apart.
-  EXPECT_TRUE(std::isnan(edgePositionVariance(draw(0.3, 0.0, 2 * kMinEdgeResiduals - 1, 5))));
-  std::vector<std::pair<double, double>> flat(500, {1.0, 4.0});
-  EXPECT_TRUE(std::isnan(edgePositionVariance(flat)));
-}
-
-// What a rendered pair's photometric residuals say of its edges: a renderer's edges lie where
-// its pixel centres sample them, well under a pixel's quantisation at the true motion (measured
-// 0.0022 forward, 0.0009 reverse); a transform 0.07 deg off (0.65 px at the image's centre,
-// 0.42 px^2) moves every edge and the residuals say so (0.59, 0.49), in both directions: why the
-// engine learns p2 from converged registrations only.
-TEST(DirectTerms, ResidualsSayWhereTheEdgesLie) {
-  const Pair p = renderedPair(true, true);
-  const DirectImages a = referenceImages(p.a);
-  const DirectImages b = directImages(p.b, false, 0.0, true);
-  const double k = M_PI / 180.0;
-  const Eigen::Isometry3d off = expSE3((Vector6d() << 0.05 * k, 0.05 * k, 0, 0, 0, 0).finished());
-  auto said = [&](const Eigen::Isometry3d& T) {
-    return std::make_pair(photometricAt(a, b, p.b, T).edgePosition2(),
-                          reversePhotometricSums(a, p.a, b, p.b, T, Brightness{}).edgePosition2());
-  };
-  const auto aligned = said(trueMotion()), misaligned = said(off * trueMotion());
-  EXPECT_LT(std::abs(aligned.first), 0.25 * kEdgePosition2);
-  EXPECT_LT(std::abs(aligned.second), 0.25 * kEdgePosition2);
-  EXPECT_GT(misaligned.first, 0.3);
-  EXPECT_GT(misaligned.second, 0.3);
-}
-
-// The engine's memory of the camera's p2: kEdgePosition2 before any registration, then the
-// median of the last kEdgePositionSamples converged ones, within [kEdgePosition2,
-// kMaxEdgePosition2]; registrations that did not converge or did not measure are left out.
-TEST(DirectTerms, TheEdgePositionIsTheMedianOfTheLastConvergedRegistrations) {
-  EdgePositionMemory memory;
-  EXPECT_EQ(memory.value(), kEdgePosition2);
-  SolverResult r;
-  r.status = SolverStatus::kConverged;
-  for (double p2 : {0.3, 0.2, 5.0}) {
-    r.edge_position2 = p2;
-    memory.add(r);
-  }
-  EXPECT_DOUBLE_EQ(memory.value(), 0.3);
-  r.edge_position2 = -1.0;  // flat residuals the larger: the floor
-  for (int k = 0; k < 4; ++k) memory.add(r);
-  EXPECT_DOUBLE_EQ(memory.value(), kEdgePosition2);
-  r.edge_position2 = 4.0;
-  for (std::size_t k = 0; k < kEdgePositionSamples; ++k) memory.add(r);
-  EXPECT_DOUBLE_EQ(memory.value(), kMaxEdgePosition2);  // the older samples are gone
-  SolverResult other = r;
-  other.edge_position2 = 0.2;
-  other.status = SolverStatus::kMaxIterations;
-  for (std::size_t k = 0; k < kEdgePositionSamples; ++k) memory.add(other);
-  other.status = SolverStatus::kConverged;
-  other.edge_position2 = std::numeric_limits<double>::quiet_NaN();
-  for (std::size_t k = 0; k < kEdgePositionSamples; ++k) memory.add(other);
-  EXPECT_DOUBLE_EQ(memory.value(), kMaxEdgePosition2);
-}
-
 // A moving cloud's grey values are smoothed at its points' pixels only: the same values as the
 // reference's whole smoothed image there, at the image's corners too (reflected border).
 TEST(DirectTerms, PointGreyValuesAreTheSmoothedImagesAtTheirPixels) {
@@ -238,7 +157,6 @@ TEST(DirectTerms, ReversePhotometricAloneConvergesToTheTrueMotion) {
   const DirectImages mov = directImages(p.b, false, 0.0, true);
   const DirectSums nothing = reverseAt(ref, p.a, directImages(p.b), p.b, trueMotion());
   EXPECT_EQ(nothing.used, 0);
-  EXPECT_TRUE(std::isnan(nothing.edgePosition2()));  // says nothing of the edges either
   const Error e =
       errorOf(iterate([&](const auto& T) { return reverseAt(ref, p.a, mov, p.b, T); }, 8));
   std::printf("  reverse photometric: %.3f mm %.4f deg\n", e.mm, e.deg);

@@ -6,7 +6,6 @@
 // and point-to-plane residuals (direct_terms.hpp) add their precision to that quadratic.
 #pragma once
 
-#include <deque>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -106,33 +105,10 @@ std::shared_ptr<CoarseToFineCloud> prepareCoarseToFine(LabelledCloud cloud,
                                                       bool as_reference);
 double prepareCoarseToFineReference(CoarseToFineCloud& cloud, const CoarseToFineParams& p);
 // `stages`: kCoarse the levels before the finest (none when there is one level: the guess comes
-// back), kFinest the finest alone. `edge_position2`: the photometric residuals' p2
-// (direct_terms.hpp); the result's edge_position2 is what its last iteration's residuals say.
+// back), kFinest the finest alone.
 SolverResult alignCoarseToFine(const CoarseToFineCloud& fixed, const CoarseToFineCloud& moving,
                                const Eigen::Isometry3d& guess, const CoarseToFineParams& p,
-                               AlignStages stages = AlignStages::kAll,
-                               double edge_position2 = kEdgePosition2);
-
-// The camera's p2 as the photometric residuals of its last kEdgePositionSamples converged
-// registrations say it (SolverResult::edge_position2): their median, within [kEdgePosition2,
-// kMaxEdgePosition2]; kEdgePosition2 before any. Mostly a property of the camera (its blur,
-// rolling shutter, colour-to-depth registration), so kept from frame to frame, as the
-// length-scale of the paper's code is (PaperParams::carry_ell); a frame's own residuals take over
-// at the last level once its steps are under kEdgePositionGate times the level's eps (1 mm and
-// 0.06 deg): learned at iterates not yet aligned, p2 took their misalignment for the camera's and
-// weakened the term that aligns them (a fast turn's frame 0.38 deg off). Over 59 sets, RPE's
-// geometric mean against p2 = 1/12: the memory alone 0.993 / 0.996, with the frame's own from a
-// gate of 5 0.983 / 0.978, of 20 0.992 / 0.982 (docs/accuracy.md, thirty-second round).
-constexpr std::size_t kEdgePositionSamples = 31;
-constexpr double kEdgePositionGate = 5.0;
-class EdgePositionMemory {
- public:
-  double value() const;
-  void add(const SolverResult& r);
-
- private:
-  std::deque<double> samples_;
-};
+                               AlignStages stages = AlignStages::kAll);
 
 class CoarseToFineEngine : public RegistrationEngine {
  public:
@@ -151,8 +127,6 @@ class CoarseToFineEngine : public RegistrationEngine {
 
  private:
   CoarseToFineParams params_;
-  // The odometry registers one frame at a time, so this state is never shared between threads.
-  mutable EdgePositionMemory edge_position_;
 };
 
 }  // namespace acvo

@@ -150,12 +150,6 @@ struct DirectSums {
   int used = 0;        // residuals summed
   double scale = 0.0;  // their learned scale (grey levels; metres per metre^2 of depth)
   Brightness brightness;  // photometric: the brightness the residuals were measured at
-  // photometric: the residuals and their says |grad I|^2, for edgePosition2
-  std::vector<std::pair<double, double>> edge_residuals;
-  // photometric: the variance of an edge's position its residuals say (edgePositionVariance;
-  // NaN where they are too few or the term had none), px^2. Computed on demand: five medians
-  // over the residuals, which the engine reads at a level's last iterations only.
-  double edgePosition2() const;
 };
 
 // A landed point's grey values as brightnessOf reads them.
@@ -168,22 +162,8 @@ struct GreyPair {
 
 // The photometric residuals' variance is s^2 + |grad I|^2 p2, s their learned scale and p2 the
 // variance of where an intensity edge lies (DSO's gradient-dependent weight, its constant
-// measured): at least a pixel's quantisation, kEdgePosition2 = 1/12 px^2 (a sensor integrates
-// over its pixel, a renderer samples its centre), and more on a real camera, whose blur,
-// rolling shutter and colour-to-depth registration move its edges. The engine learns p2 from
-// the residuals of the registrations it ran (CoarseToFineEngine), within [kEdgePosition2,
-// kMaxEdgePosition2].
+// measured): a pixel's quantisation, kEdgePosition2 = 1/12 px^2.
 constexpr double kEdgePosition2 = 1.0 / 12.0;  // px^2
-constexpr double kMaxEdgePosition2 = 1.0;      // px^2
-// The p2 that residuals r with their says |grad I|^2 show: r^2 = s^2 + say p2 fitted through the
-// lower and upper halves of the residuals by say (each half's median r^2, a normal's 0.4549 of
-// its variance, against its median say; medians, so that occluded and moved points count as
-// little as in the scale). Not clamped (negative where the flat residuals are the larger); NaN
-// with fewer than kMinEdgeResiduals in either half.
-constexpr std::size_t kMinEdgeResiduals = 50;
-double edgePositionVariance(const std::vector<std::pair<double, double>>& residual_and_say);
-// p2 as the terms use it: within [kEdgePosition2, kMaxEdgePosition2].
-double usableEdgePosition(double p2);
 
 // r_j = I_ref(pi(T z_j)) - B_j I_moving(pixel_j) over the landed points, B_j the brightness
 // from the moving image to the reference at that point: 1, or brightnessOf their grey values

@@ -11,7 +11,6 @@
 #include <Eigen/Cholesky>
 
 #include "acvo/covariance.hpp"
-#include "acvo/order_statistics.hpp"
 
 namespace acvo {
 namespace {
@@ -39,29 +38,13 @@ struct LevelDirect {
   const DirectImages* moving = nullptr;
   const LabelledCloud* moving_cloud = nullptr;
   const LabelledCloud* reference_cloud = nullptr;
-  double edge_position2 = kEdgePosition2;  // the photometric residuals' p2 (direct_terms.hpp)
-};
-
-// The photometric residuals of an iteration in both directions, kept for what they say of the
-// edges (DirectSums::edgePosition2), which costs five medians each and is read only once the
-// steps are small and at a level's end.
-struct EdgeResiduals {
-  DirectSums forward, reverse;
-  // Either direction's p2 alone when the other had too few residuals; NaN without the term.
-  double p2() const {
-    const double d = forward.edgePosition2(), r = reverse.edgePosition2();
-    if (!std::isfinite(d)) return r;
-    if (!std::isfinite(r)) return d;
-    return (1.0 - kReverseShare) * d + kReverseShare * r;
-  }
 };
 
 // The step's quadratic: the kernel's, plus the direct terms' where the level has them. Returns
 // the factor that took the kernel's sums to the terms' units.
 double addDirectTerms(const LevelSums& s, double ell, const LevelDirect& direct,
                       const CoarseToFineParams& p, const Eigen::Isometry3d& T, Matrix6d& H,
-                      Vector6d& g, Brightness& brightness, EdgeResiduals& edges,
-                      PlaneMemo& planes) {
+                      Vector6d& g, Brightness& brightness, PlaneMemo& planes) {
   // The kernel's quadratic is sum a_ij (x_i - y)^T W (x_i - y) / 2 ell_j^2 but for the factor
   // ell^2 its sums leave out: divided by ell^2 and by the mean kernel mass of a matched point,
   // each matched point weighs as one position known to ell_j, the scale the terms below are in.
@@ -74,17 +57,15 @@ double addDirectTerms(const LevelSums& s, double ell, const LevelDirect& direct,
   const std::vector<Landing> landed =
       landings(*direct.reference, *direct.moving, *direct.moving_cloud, T);
   if (p.photometric) {
-    DirectSums d =
+    const DirectSums d =
         photometricSums(*direct.reference, *direct.moving, *direct.moving_cloud, landed,
-                        p.photometric_gain, p.photometric_vignetting, direct.edge_position2);
+                        p.photometric_gain, p.photometric_vignetting);
     brightness = d.brightness;
-    DirectSums r =
+    const DirectSums r =
         reversePhotometricSums(*direct.reference, *direct.reference_cloud, *direct.moving,
-                               *direct.moving_cloud, T, d.brightness, direct.edge_position2);
+                               *direct.moving_cloud, T, d.brightness);
     H += (1.0 - kReverseShare) * d.H + kReverseShare * r.H;
     g += (1.0 - kReverseShare) * d.g + kReverseShare * r.g;
-    edges.forward = std::move(d);
-    edges.reverse = std::move(r);
   }
   if (p.point_to_plane) {
     const DirectSums d = pointToPlaneSums(*direct.reference, landed, planeFadeNoise(p), &planes);
@@ -100,19 +81,12 @@ double addDirectTerms(const LevelSums& s, double ell, const LevelDirect& direct,
 }
 
 // Iterates one level from T; returns false when a step was not finite.
-bool iterateLevel(LevelKernel& kernel, const LevelDirect& level_direct, double ell, double eps,
+bool iterateLevel(LevelKernel& kernel, const LevelDirect& direct, double ell, double eps,
                   bool last, const CoarseToFineParams& p, Eigen::Isometry3d& T,
                   SolverResult& result) {
   Vector6d previous = Vector6d::Zero();
-  LevelDirect direct = level_direct;
   PlaneMemo planes;
   for (int it = 0; it < p.level_iterations; ++it) {
-    // Once the steps are small, this frame's residuals say its own edges' p2 (kEdgePositionGate).
-    const bool settled = it > 0 && std::isfinite(result.edge_position2) &&
-                         previous.head<3>().norm() < kEdgePositionGate * eps &&
-                         previous.tail<3>().norm() < kEdgePositionGate * eps;
-    direct.edge_position2 =
-        settled ? usableEdgePosition(result.edge_position2) : level_direct.edge_position2;
     const auto t0 = Clock::now();
     const LevelSums& s = kernel.evaluate(T, ell);
     Matrix6d H = s.H;
@@ -120,37 +94,21 @@ bool iterateLevel(LevelKernel& kernel, const LevelDirect& level_direct, double e
     // The information of the registration: the quadratic's, in the kernel's own units (those
     // covariance_scale was calibrated in).
     result.hessian = -s.H;
-    EdgeResiduals edges;
     if (direct.reference) {
       Brightness brightness;
-      const double to_units =
-          addDirectTerms(s, ell, direct, p, T, H, g, brightness, edges, planes);
+      const double to_units = addDirectTerms(s, ell, direct, p, T, H, g, brightness, planes);
       result.brightness_gain = brightness.gain;
       result.vignetting = brightness.vignetting;
       if (to_units > 0.0) result.hessian = -H / to_units;
     }
-    // result.edge_position2: what this iteration's residuals say, where it is read: by the next
-    // iteration when this step settles it, and at the level's end.
-    auto sayEdges = [&] {
-      if (!direct.reference) return;
-      const auto t1 = Clock::now();
-      result.edge_position2 = edges.p2();
-      result.ms_neighbours += msSince(t1);
-    };
     result.ms_neighbours += msSince(t0);
     const Eigen::Isometry3d step = levelStep(H, g);
-    if (!step.matrix().allFinite()) {
-      sayEdges();
-      return false;
-    }
+    if (!step.matrix().allFinite()) return false;
     // The direct terms converge as Gauss-Newton does, not as the kernel's slow
     // minorise-maximise: their steps are taken as they are.
     const double acceleration = direct.reference ? 0.0 : p.level_acceleration;
     const Vector6d xi = extrapolatedStep(logSE3(step), previous, acceleration);
     const bool converged = xi.head<3>().norm() < eps && xi.tail<3>().norm() < eps;
-    const bool settles = xi.head<3>().norm() < kEdgePositionGate * eps &&
-                         xi.tail<3>().norm() < kEdgePositionGate * eps;
-    if (converged || settles || it + 1 == p.level_iterations) sayEdges();
     T = normalized(expSE3(xi) * T);
     previous = xi;
     result.trace.push_back({ell, ell, 1.0, xi.norm(), s.F, s.nnz});
@@ -216,7 +174,7 @@ double prepareCoarseToFineReference(CoarseToFineCloud& cloud, const CoarseToFine
 
 SolverResult alignCoarseToFine(const CoarseToFineCloud& fixed, const CoarseToFineCloud& moving,
                                const Eigen::Isometry3d& guess, const CoarseToFineParams& p,
-                               AlignStages stages, double edge_position2) {
+                               AlignStages stages) {
   const auto t_start = Clock::now();
   SolverResult result;
   result.transform = guess;
@@ -256,7 +214,7 @@ SolverResult alignCoarseToFine(const CoarseToFineCloud& fixed, const CoarseToFin
     const double eps = p.level_eps * ell / ells.back();
     LevelDirect direct;
     if (last && directTerms(p) && fixed.images.isReference() && !moving.images.empty()) {
-      direct = {&fixed.images, &moving.images, &moving.cloud, &fixed.cloud, edge_position2};
+      direct = {&fixed.images, &moving.images, &moving.cloud, &fixed.cloud};
       if (p.dense_point_to_plane) result.dense_weight = denseWeight(fixed.images, moving.images);
     }
     if (!iterateLevel(*kernel, direct, ell, eps, last, p, T, result)) {
@@ -294,25 +252,10 @@ double CoarseToFineEngine::prepareReference(PreparedCloud& cloud) const {
   return prepareCoarseToFineReference(static_cast<CoarseToFineCloud&>(cloud), params_);
 }
 
-double EdgePositionMemory::value() const {
-  if (samples_.empty()) return kEdgePosition2;
-  std::vector<double> values(samples_.begin(), samples_.end());
-  return usableEdgePosition(upperMedian(values));
-}
-
-void EdgePositionMemory::add(const SolverResult& r) {
-  if (r.status != SolverStatus::kConverged || !std::isfinite(r.edge_position2)) return;
-  samples_.push_back(r.edge_position2);
-  if (samples_.size() > kEdgePositionSamples) samples_.pop_front();
-}
-
 SolverResult CoarseToFineEngine::align(const PreparedCloud& fixed, const PreparedCloud& moving,
                                        const Eigen::Isometry3d& guess, AlignStages stages) const {
-  SolverResult r = alignCoarseToFine(static_cast<const CoarseToFineCloud&>(fixed),
-                                     static_cast<const CoarseToFineCloud&>(moving), guess,
-                                     params_, stages, edge_position_.value());
-  edge_position_.add(r);
-  return r;
+  return alignCoarseToFine(static_cast<const CoarseToFineCloud&>(fixed),
+                           static_cast<const CoarseToFineCloud&>(moving), guess, params_, stages);
 }
 
 std::optional<Matrix6d> CoarseToFineEngine::covariance(const SolverResult& s,

@@ -184,52 +184,8 @@ DirectSums sumsOf(std::vector<Residual>& residuals, double min_scale, double pos
   return s;
 }
 
-std::vector<std::pair<double, double>> edgeResidualsOf(const std::vector<Residual>& residuals) {
-  std::vector<std::pair<double, double>> pairs;
-  pairs.reserve(residuals.size());
-  for (const Residual& q : residuals) pairs.emplace_back(q.r, q.say);
-  return pairs;
-}
-
 }  // namespace
 
-namespace {
-
-// upperMedian of values[begin, end).
-double upperMedianOf(std::vector<double>& values, std::size_t begin, std::size_t end) {
-  return kthSmallest(values.data() + begin, values.data() + end, (end - begin) / 2);
-}
-
-}  // namespace
-
-double edgePositionVariance(const std::vector<std::pair<double, double>>& residual_and_say) {
-  const std::size_t n = residual_and_say.size();
-  if (n < 2 * kMinEdgeResiduals) return std::numeric_limits<double>::quiet_NaN();
-  std::vector<double> says(n);
-  for (std::size_t k = 0; k < n; ++k) says[k] = residual_and_say[k].second;
-  const double cut = upperMedian(says);
-  // The halves side by side in two buffers, the lower from the front, the upper from the back
-  // (a median does not depend on the order).
-  std::vector<double> r2(n);
-  std::size_t low = 0, high = n;
-  for (const auto& [r, say] : residual_and_say) {
-    const std::size_t k = say < cut ? low++ : --high;
-    r2[k] = r * r;
-    says[k] = say;
-  }
-  if (low < kMinEdgeResiduals || n - high < kMinEdgeResiduals) {
-    return std::numeric_limits<double>::quiet_NaN();
-  }
-  const double say_step = upperMedianOf(says, high, n) - upperMedianOf(says, 0, low);
-  if (!(say_step > 0.0)) return std::numeric_limits<double>::quiet_NaN();
-  // A normal's squared values have their median at 0.4549 of its variance.
-  constexpr double kMedianOfSquares = 0.4549;
-  return (upperMedianOf(r2, high, n) - upperMedianOf(r2, 0, low)) / (kMedianOfSquares * say_step);
-}
-
-double DirectSums::edgePosition2() const { return edgePositionVariance(edge_residuals); }
-
-double usableEdgePosition(double p2) { return std::clamp(p2, kEdgePosition2, kMaxEdgePosition2); }
 
 namespace {
 
@@ -541,7 +497,6 @@ DirectSums photometricSums(const DirectImages& reference, const DirectImages& mo
   DirectSums s =
       sumsOf(residuals, kMinIntensityScale, edge_position2, [](double) { return 1.0; });
   s.brightness = b;
-  s.edge_residuals = edgeResidualsOf(residuals);
   return s;
 }
 
@@ -596,10 +551,7 @@ DirectSums reversePhotometricSums(const DirectImages& reference,
     q.J << -b * e.cross(x), b * e;
     residuals.push_back(q);
   }
-  DirectSums s =
-      sumsOf(residuals, kMinIntensityScale, edge_position2, [](double) { return 1.0; });
-  s.edge_residuals = edgeResidualsOf(residuals);
-  return s;
+  return sumsOf(residuals, kMinIntensityScale, edge_position2, [](double) { return 1.0; });
 }
 
 DirectSums pointToPlaneSums(const DirectImages& reference, const std::vector<Landing>& landed,
