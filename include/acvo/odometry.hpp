@@ -18,7 +18,7 @@
 #include "acvo/params.hpp"
 #include "acvo/registration.hpp"
 #include "acvo/se3.hpp"
-#include "acvo/velocity_filter.hpp"
+#include "acvo/velocity_changes.hpp"
 
 namespace acvo {
 
@@ -73,11 +73,6 @@ struct OdometryResult {
   // ... and moved (again) by the motion the registration's first stages found for this frame,
   // which matches its colour better than the last frame's motion can.
   bool depth_retimed = false;
-  // Where the registration ran in two stages for a delay: the weight VelocityFilter gave the
-  // frame's own velocity against the last frame's, rotation and translation (the mean of the
-  // gain's diagonal over each: near 0 the last frame's, near 1 its own; a little outside where
-  // one part's correction comes from the other's); NaN otherwise.
-  Eigen::Vector2d own_velocity_weight = Eigen::Vector2d::Constant(std::nan(""));
   // building this frame's cloud (the depth moved to the colour's time, selection, labels,
   // self-kernel)
   double ms_cloud = 0.0;
@@ -125,7 +120,7 @@ inline constexpr double kSecondStartKeptMargin = 2.0;
 inline constexpr double kSecondStartMemory = 0.25;  // s
 // Under those limits a registration whose motion misses the guess by more than
 // kSecondStartCheckSigmas times the guess's usual miss (the root mean square of the camera's
-// recent velocity changes over the interval, VelocityFilter::changeMoment), and by at least
+// recent velocity changes over the interval, VelocityChanges), and by at least
 // kSecondStartCheckTranslation or kSecondStartCheckRotation (grown with the interval as the
 // limits), gets a second start too; only where the guess is the constant-velocity prediction
 // from a known velocity (not an identity guess, nor one given from outside, whose usual miss is
@@ -382,8 +377,8 @@ class Odometry {
   Matrix6d pose_covariance_;
   Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();  // last frame-to-frame motion
   double velocity_interval_ = 0.0;  // s between the two frames of velocity_ (0: unknown)
-  // The velocity over a colour/depth delay: velocity_ against the frame's own (retimedCloud).
-  VelocityFilter velocity_filter_;
+  // How the velocity has been changing between tracked frames (the second start's check).
+  VelocityChanges velocity_changes_;
   std::optional<Tracked> keyframe_;
   std::optional<Tracked> last_;  // the last tracked frame (the keyframe itself, or after it)
   int lost_in_a_row_ = 0;

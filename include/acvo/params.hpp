@@ -168,10 +168,9 @@ struct OdometryParams {
   double lost_speed = 1.0;           // m/s
   double lost_angular_speed = 90.0;  // deg/s
   // Colour and depth taken at different times (Frame::depth_stamp): the depth is moved to the
-  // colour's time by the last frame-to-frame motion (constant velocity), then again at a
-  // velocity weighed between that and the frame's own as the registration's first stages find
-  // it (VelocityFilter), so that each point's colour and position are of one instant. Off: the
-  // two are paired as they come.
+  // colour's time by the last frame-to-frame motion (constant velocity), then again at the
+  // frame's own velocity as the registration's coarse levels find it, so that each point's
+  // colour and position are of one instant. Off: the two are paired as they come.
   bool sync_depth = true;
   // Once the colour check (ColourDepthCheck) finds the depth not registered to the colour (a
   // second camera's colour, 7-Scenes'), each frame's colour is resampled to the depth camera's

@@ -162,8 +162,6 @@ class OdometryNodelet : public nodelet::Nodelet {
     double ms_latency = 0.0;
     double depth_delay = 0.0;   // s from the depth's stamp to the colour's
     bool depth_synced = false;  // the depth was moved to the colour's time
-    // The velocity filter's weight of the frame's own velocity (rotation, translation; NaN: none).
-    Eigen::Vector2d own_velocity_weight = Eigen::Vector2d::Constant(std::nan(""));
     // The dense depth term's weight (NaN: not in use).
     double dense_weight = std::nan("");
     ros::WallTime wall;  // last synchronised frame, good or bad
@@ -395,7 +393,6 @@ void OdometryNodelet::processFrame(const Image& rgb, const Image& depth, const I
   last_.message = r.message;
   last_.depth_delay = r.depth_delay;
   last_.depth_synced = r.depth_synced || r.depth_retimed;
-  last_.own_velocity_weight = r.own_velocity_weight;
   last_.dense_weight = r.solver.dense_weight;
   if (last_.depth_synced && !depth_sync_told_) {
     depth_sync_told_ = true;
@@ -815,17 +812,8 @@ void OdometryNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat
   stat.add("colour/depth registration",
            acvo::toString(odometry_->colourCheck().verdict().state) +
                (odometry_->colourResampling() ? " (colour resampled to the depth camera)" : ""));
-  std::string moved;
-  if (last_.depth_synced) {
-    moved = ", depth moved to the colour's time";
-    if (last_.own_velocity_weight.allFinite()) {
-      char weights[96];
-      std::snprintf(weights, sizeof weights, " (own velocity weighed %.2f rot, %.2f trans)",
-                    last_.own_velocity_weight[0], last_.own_velocity_weight[1]);
-      moved += weights;
-    }
-  }
-  stat.addf("colour stamp - depth stamp (ms)", "%.2f%s", 1e3 * last_.depth_delay, moved.c_str());
+  const char* moved = last_.depth_synced ? ", depth moved to the colour's time" : "";
+  stat.addf("colour stamp - depth stamp (ms)", "%.2f%s", 1e3 * last_.depth_delay, moved);
   stat.add("dense depth term weight", denseWeightText(last_.dense_weight, last_.depth_delay));
   stat.add("parameter problems",
            parameter_problems_.empty() ? std::string("none") : parameter_problems_);

@@ -134,7 +134,7 @@ int main(int argc, char** argv) {
                "inner_product,matched_fraction,ms_selection,ms_labels,ms_prepare,ms_cloud,ms_"
                "neighbours,ms_step,ms_ell,"
                "ms_registration,ms_frame,rss_kib,keyframe,new_keyframe,depth_delay_ms,"
-               "depth_moved,own_velocity_weight_rot,own_velocity_weight_trans,brightness_gain,"
+               "depth_moved,brightness_gain,"
                "vignetting,dense_weight,second_start\n";
     }
 
@@ -192,8 +192,7 @@ int main(int argc, char** argv) {
               << s.ms_neighbours << ',' << s.ms_step << ',' << s.ms_ell << ',' << r.ms_registration
               << ',' << ms << ',' << acvo::tools::residentKiB() << ',' << r.keyframe_index << ','
               << int(r.new_keyframe) << ',' << 1e3 * r.depth_delay << ','
-              << (r.depth_retimed ? 2 : int(r.depth_synced)) << ',' << r.own_velocity_weight[0]
-              << ',' << r.own_velocity_weight[1] << ',' << s.brightness_gain << ',' << s.vignetting
+              << (r.depth_retimed ? 2 : int(r.depth_synced)) << ',' << s.brightness_gain << ',' << s.vignetting
               << ',' << s.dense_weight << ','
               << (r.second_start_kept ? 2 : int(r.second_start))
               << '\n';

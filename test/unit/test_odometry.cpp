@@ -266,13 +266,6 @@ TEST(Odometry, DepthOfAnotherInstantIsMovedByTheFramesOwnMotion) {
       EXPECT_NEAR(r.depth_delay, 0.012, 1e-9);
       EXPECT_EQ(r.depth_synced, sync && i >= 2) << "frame " << i;
       EXPECT_EQ(r.depth_retimed, sync && i >= 1) << "frame " << i;
-      // The filter's weight of the frame's own velocity: where the depth was moved again.
-      const Eigen::Vector2d w = r.own_velocity_weight;
-      if (sync && i >= 1) {
-        EXPECT_TRUE(w.allFinite()) << w.transpose();
-      } else {
-        EXPECT_TRUE(w.hasNaN()) << "frame " << i;
-      }
       if (i == 0) continue;
       // The exact depth at the colour's instant, against the cloud's and the depth as it came:
       // the medians of the differences (a pixel on a depth edge is off by the edge's step).
@@ -305,7 +298,6 @@ TEST(Odometry, DepthOfAnotherInstantIsMovedByTheFramesOwnMotion) {
   for (int i = 0; i < same.size(); ++i) {
     const OdometryResult r = odo.process(same.frame(i).toFrame());
     EXPECT_FALSE(r.depth_synced || r.depth_retimed);
-    EXPECT_TRUE(r.own_velocity_weight.hasNaN());
   }
 }
 

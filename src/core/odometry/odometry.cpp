@@ -26,12 +26,8 @@ struct Odometry::Arena {
 // One registration of the current frame to a reference, judged, with its covariance.
 struct Odometry::Registration {
   // The cloud registered: the frame's own, or its cloud with the depth moved to the colour's
-  // time again at the velocity this registration found, weighed against the last frame's
-  // (retimedCloud, VelocityFilter).
+  // time again at the velocity this registration's coarse levels found (retimedCloud).
   std::shared_ptr<PreparedCloud> moving;
-  // This frame's velocity (twist per second) as the coarse levels found it, where the
-  // registration ran in two stages.
-  std::optional<Vector6d> coarse_velocity;
   cv::Mat moved_depth;  // the depth `moving` took its points from, where moved again
   SolverResult solver;
   Judgement judgement;
@@ -207,7 +203,7 @@ void Odometry::reset(const Eigen::Isometry3d& pose, const Matrix6d& covariance) 
   velocity_ = Eigen::Isometry3d::Identity();
   velocity_interval_ = 0.0;
   motion_known_ = false;
-  velocity_filter_.reset();
+  velocity_changes_.reset();
   keyframe_.reset();
   last_.reset();
   lost_in_a_row_ = 0;
@@ -257,15 +253,8 @@ Odometry::Registration Odometry::registerTo(const Tracked& reference,
       reg.solver = coarse;
       return;
     }
-    // The velocity over the delay: this frame's own as the coarse levels found it, weighed
-    // against the last frame's by what each has missed so far (VelocityFilter).
-    // Until a last velocity is known, the frame's own.
-    reg.coarse_velocity = logSE3(frameMotion(coarse.transform)) / r.interval;
-    const std::optional<Vector6d> last = lastVelocity();
-    const Matrix6d gain = last ? velocity_filter_.gain() : Matrix6d::Identity();
-    r.own_velocity_weight = {gain.diagonal().head<3>().mean(), gain.diagonal().tail<3>().mean()};
-    const Vector6d velocity =
-        last ? VelocityFilter::blend(gain, *last, *reg.coarse_velocity) : *reg.coarse_velocity;
+    // The velocity over the delay: this frame's own, as the coarse levels found it.
+    const Vector6d velocity = logSE3(frameMotion(coarse.transform)) / r.interval;
     if (auto again = retimedCloud(*current, frame, velocity, r, &reg.moved_depth)) {
       reg.moving = std::move(again);
     }
@@ -414,7 +403,7 @@ OdometryResult Odometry::track(const Frame& frame,
       motion_guess        ? *motion_guess
       : constant_velocity ? motionPrior(velocity_, velocity_interval_, r.interval)
                           : Eigen::Isometry3d::Identity();
-  guess_predicted_ = constant_velocity && lastVelocity() && velocity_filter_.changes() > 0;
+  guess_predicted_ = constant_velocity && lastVelocity() && velocity_changes_.count() > 0;
   guess_unknown_ = constant_velocity && !motion_known_;
   Registration reg = registerFrame(r, frame, current, prior);
   // A lost frame's motion moves no depth: its cloud is kept as built (it may become the
@@ -642,7 +631,7 @@ void Odometry::secondStart(const Tracked& reference, const Eigen::Isometry3d& gu
     // such measure. The sigmas grow with the interval, the floors with its square (a frame
     // dropped: the guess misses by the velocity times the interval's excess).
     if (!guess_predicted_) return;
-    const Matrix6d& change = velocity_filter_.changeMoment();
+    const Matrix6d& change = velocity_changes_.moment();
     const double usual_m = std::sqrt(change.block<3, 3>(3, 3).trace()) * r.interval;
     const double usual_deg =
         std::sqrt(change.block<3, 3>(0, 0).trace()) * r.interval * 180.0 / M_PI;
@@ -720,8 +709,7 @@ void Odometry::tracked(OdometryResult& r, const Registration& reg,
   r.pose_covariance = pose_covariance_;
   if (r.interval > 0.0) {
     const Vector6d velocity = logSE3(r.motion) / r.interval;
-    if (const auto last = lastVelocity()) velocity_filter_.addChange(velocity - *last);
-    if (reg.coarse_velocity) velocity_filter_.addCorrection(velocity - *reg.coarse_velocity);
+    if (const auto last = lastVelocity()) velocity_changes_.add(velocity - *last);
   }
   velocity_ = r.motion;
   velocity_interval_ = r.interval;
