@@ -61,11 +61,6 @@ LabelledCloud buildLabelledCloud(const Frame& frame, const SelectionParams& para
 LabelledCloud withDepth(const LabelledCloud& cloud, const cv::Mat& depth_m,
                         const SelectionParams& params);
 
-// An even share of the cloud's points: those at floor(k * step), k = 0, 1, ... (step >= 1),
-// with the cloud's images, camera and stamps. The selector lists its pixels in row-major
-// order, so a share keeps the selection's spread over the image.
-LabelledCloud everyNth(const LabelledCloud& cloud, double step);
-
 // A cloud with `cloud`'s images, camera, stamp and motions and room for `count` points, none yet.
 LabelledCloud withoutPoints(const LabelledCloud& cloud, std::size_t count);
 

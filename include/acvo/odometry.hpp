@@ -313,15 +313,11 @@ class Odometry {
   std::optional<Vector6d> lastVelocity() const;
   // The frame with its depth moved to the colour's time when they differ (sync_depth).
   Frame depthAtColourTime(const Frame& frame, OdometryResult& r) const;
-  // The cloud of the frame at its colour's time, the share of it registered where the reference
-  // is denser (selection.reference_density; the whole selection is kept in selected_).
+  // The cloud of the frame at its colour's time.
   std::shared_ptr<PreparedCloud> buildCloud(const Frame& frame, OdometryResult& r);
-  // The cloud that makes this frame a reference: its whole selection (selected_) with its depth
-  // from `depth` when the registered cloud's was moved again (retimedCloud), else `registered`
-  // itself. Search grids built (asReference).
+  // `cloud` with the search grids of a reference built (asReference).
   std::shared_ptr<PreparedCloud> asReferenceCloud(OdometryResult& r,
-                                                  const std::shared_ptr<PreparedCloud>& registered,
-                                                  const cv::Mat& depth = cv::Mat());
+                                                  const std::shared_ptr<PreparedCloud>& cloud);
   void start(OdometryResult& r, const std::shared_ptr<PreparedCloud>& registered);
   // To the keyframe from the prior, then (lost) to the last tracked frame; fills r's solver
   // figures and judgement.
@@ -361,11 +357,10 @@ class Odometry {
   // engine).
   bool retimes(const OdometryResult& r) const;
   // The frame's cloud with its depth moved to the colour's time at `velocity` (a twist per
-  // second), when that moves a pixel by a tenth or more against what the cloud was built with,
-  // and that depth in *depth; null otherwise.
+  // second), when that moves a pixel by a tenth or more against what the cloud was built with;
+  // null otherwise.
   std::shared_ptr<PreparedCloud> retimedCloud(const PreparedCloud& current, const Frame& frame,
-                                              const Vector6d& velocity, OdometryResult& r,
-                                              cv::Mat* depth) const;
+                                              const Vector6d& velocity, OdometryResult& r) const;
   void tracked(OdometryResult& r, const Registration& reg,
                const std::shared_ptr<PreparedCloud>& current);
   void lost(OdometryResult& r, const Registration& reg,
@@ -401,9 +396,6 @@ class Odometry {
   // Each frame's colour is resampled by it (colourResampling), and by the verdict's baseline with
   // resample_colour_baseline (resampled()).
   std::optional<double> colour_ratio_;
-  // The current frame's whole selection where registered clouds are a share of it
-  // (selection.reference_density > 1): the cloud it keeps if it becomes a reference.
-  std::optional<LabelledCloud> selected_;
   struct Arena;               // the thread pool the solver runs in (odometry.threads)
   std::unique_ptr<Arena> arena_;
 };

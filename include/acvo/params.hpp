@@ -27,12 +27,6 @@ struct SelectionParams {
   // over 640 (the square root of its pixels over 640x480's): edges, where points are chosen,
   // grow with the width, and a dense peer's cost with the pixels.
   bool scale_with_image = true;
-  // A keyframe's cloud holds reference_density times as many points as a registered one: each
-  // frame is selected at target_points x reference_density and registers an even share of
-  // 1 / reference_density of those points; the frame that becomes a keyframe keeps them all. A
-  // denser reference gives more of a moving point's kernel partners within the finest
-  // length-scale (docs/accuracy.md, nineteenth round). 1: every cloud as selected.
-  double reference_density = 1.0;
 };
 
 struct RegistrationParams {
@@ -236,7 +230,6 @@ void visitParams(Params_& p, Visitor&& visit) {
   visit("selection", "max_depth", p.selection.max_depth);
   visit("selection", "canny_fallback", p.selection.canny_fallback);
   visit("selection", "scale_with_image", p.selection.scale_with_image);
-  visit("selection", "reference_density", p.selection.reference_density);
   visit("registration", "engine", p.registration.engine);
   auto& c = p.coarse_to_fine;
   visit("coarse_to_fine", "ell_init", c.ell_init);

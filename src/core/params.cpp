@@ -154,8 +154,6 @@ std::string validate(const Params& p) {
   check(why, se.target_points > 0, "selection.target_points", "must be positive");
   check(why, se.min_depth >= 0.0, "selection.min_depth", "must not be negative");
   check(why, se.min_depth < se.max_depth, "selection.min_depth", "must be below max_depth");
-  check(why, se.reference_density >= 1.0 && se.reference_density <= 4.0,
-        "selection.reference_density", "must lie in [1, 4]");
   const CoarseToFineParams& c = p.coarse_to_fine;
   check(why, c.ell_min > 0.0, "coarse_to_fine.ell_min", "must be positive");
   check(why, c.ell_init >= c.ell_min, "coarse_to_fine.ell_init", "must not be below ell_min");

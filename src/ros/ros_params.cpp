@@ -154,7 +154,6 @@ acvo::AcvoConfig toConfig(const acvo::Params& params, LostOdom lost_odom) {
   c.target_points = params.selection.target_points;
   c.min_depth = params.selection.min_depth;
   c.max_depth = params.selection.max_depth;
-  c.reference_density = params.selection.reference_density;
   c.engine = acvo::toString(params.registration.engine);
   c.ell_init = params.coarse_to_fine.ell_init;
   c.ell_min = params.coarse_to_fine.ell_min;
@@ -186,7 +185,6 @@ acvo::Params fromConfig(const acvo::AcvoConfig& config, acvo::Params base) {
   base.selection.target_points = config.target_points;
   base.selection.min_depth = config.min_depth;
   base.selection.max_depth = config.max_depth;
-  base.selection.reference_density = config.reference_density;
   acvo::fromString(config.engine, base.registration.engine);
   base.coarse_to_fine.ell_init = config.ell_init;
   base.coarse_to_fine.ell_min = config.ell_min;

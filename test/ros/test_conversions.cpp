@@ -615,7 +615,6 @@ TEST(RosParams, UnknownNamesAreReportedWithTheNameTheyHaveHere) {
 TEST(RosParams, ReconfigureRoundTripsAndDescribesEveryParameter) {
   acvo::Params p;
   p.selection.target_points = 777;
-  p.selection.reference_density = 2.0;
   p.registration.engine = acvo::Engine::kPaper;
   p.paper.ell_policy = acvo::EllPolicy::kFixedSchedule;
   p.paper.color_ell = 0.25;

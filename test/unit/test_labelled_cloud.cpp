@@ -278,38 +278,6 @@ TEST(LabelledCloud, WithDepthKeepsThePixelsAndTakesTheirPointsFromTheNewDepth) {
   EXPECT_THROW(withDepth(cloud, cv::Mat(10, 10, CV_32FC1), params), std::invalid_argument);
 }
 
-// A share of a cloud: the points at floor(k * step), each with its own label, colour and pixel,
-// and the cloud's images.
-TEST(LabelledCloud, EveryNthKeepsAnEvenShareWithTheImages) {
-  const Frame f = frameOf(primaries(), ColorOrder::kRgb, 2.f);
-  const LabelledCloud cloud = buildLabelledCloud(f, SelectionParams());
-  ASSERT_GT(cloud.size(), 20u);
-  const LabelledCloud all = everyNth(cloud, 1.0);
-  EXPECT_EQ(all.pixels, cloud.pixels);
-  EXPECT_EQ(all.points, cloud.points);
-
-  const LabelledCloud half = everyNth(cloud, 2.0);
-  EXPECT_EQ(half.size(), (cloud.size() + 1) / 2);
-  const LabelledCloud share = everyNth(cloud, 2.5);  // 0, 2, 5, 7, 10, ...
-  ASSERT_EQ(share.size(), std::size_t(std::ceil(double(cloud.size()) / 2.5)));
-  EXPECT_EQ(share.labels.size(), share.size());
-  EXPECT_EQ(share.rgb.size(), share.size());
-  EXPECT_EQ(share.pixels.size(), share.size());
-  for (std::size_t k = 0; k < share.size(); ++k) {
-    const auto i = std::size_t(std::floor(double(k) * 2.5));
-    ASSERT_EQ(share.pixels[k], cloud.pixels[i]);
-    EXPECT_EQ(share.points[k], cloud.points[i]);
-    EXPECT_EQ(share.labels[k], cloud.labels[i]);
-    EXPECT_EQ(share.rgb[k], cloud.rgb[i]);
-  }
-  EXPECT_EQ(share.gray.data, cloud.gray.data);
-  EXPECT_EQ(share.depth.data, cloud.depth.data);
-  EXPECT_EQ(share.stamp, cloud.stamp);
-  EXPECT_EQ(share.width, cloud.width);
-  EXPECT_THROW(everyNth(cloud, 0.5), std::invalid_argument);
-  EXPECT_THROW(everyNth(cloud, std::nan("")), std::invalid_argument);
-}
-
 TEST(LabelledCloud, RejectsUnusableFrames) {
   Frame f = frameOf(primaries(), ColorOrder::kRgb);
   f.depth = cv::Mat();

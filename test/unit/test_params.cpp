@@ -55,7 +55,7 @@ TEST(Params, ConfigFileHoldsEveryKeyWithTheStructDefaults) {
   const Params loaded = loadParams(path);
   const auto got = flatten(loaded);
   const auto want = flatten(Params());
-  ASSERT_EQ(got.size(), 67u);  // every parameter of visitParams
+  ASSERT_EQ(got.size(), 66u);  // every parameter of visitParams
   EXPECT_EQ(got, want);
   // Equal values could also come from keys missing in the file: check that each key of the
   // sections the default engine reads is written, and that the other engine's is not there.
@@ -140,7 +140,7 @@ TEST(Params, EveryKeyIsReadIntoItsField) {
 TEST(Params, ValuesOverrideTheBase) {
   const Params p = parseParams(
       "selection:\n  target_points: 1500\n  canny_fallback: false\n"
-      "  scale_with_image: false\n  reference_density: 2.5\n"
+      "  scale_with_image: false\n"
       "paper:\n  ell_update: descent\n  color_ell: 0.1\n"
       "odometry:\n  initial_guess: identity\n  threads: 2\n");
   EXPECT_EQ(p.selection.target_points, 1500);
@@ -148,7 +148,6 @@ TEST(Params, ValuesOverrideTheBase) {
   EXPECT_FALSE(p.selection.scale_with_image);
   EXPECT_TRUE(Params().selection.scale_with_image);
   EXPECT_FALSE(acvo::paperParams().selection.scale_with_image);
-  EXPECT_DOUBLE_EQ(p.selection.reference_density, 2.5);
   EXPECT_EQ(p.paper.ell_update, EllUpdate::kDescent);
   EXPECT_DOUBLE_EQ(p.paper.color_ell, 0.1);
   EXPECT_EQ(p.odometry.initial_guess, InitialGuess::kIdentity);
@@ -291,12 +290,6 @@ TEST(Params, ValidateCatchesInconsistentValues) {
   EXPECT_NE(message([](Params& p) { p.selection.target_points = -5; }).find("target_points"),
             std::string::npos);
   EXPECT_NE(message([](Params& p) { p.selection.min_depth = 16.0; }).find("min_depth"),
-            std::string::npos);
-  EXPECT_NE(message([](Params& p) { p.selection.reference_density = 0.5; })
-                .find("reference_density"),
-            std::string::npos);
-  EXPECT_NE(message([](Params& p) { p.selection.reference_density = 5.0; })
-                .find("reference_density"),
             std::string::npos);
   EXPECT_NE(message([](Params& p) { p.selection.min_depth = 17.0; }).find("min_depth"),
             std::string::npos);

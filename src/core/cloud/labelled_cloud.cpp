@@ -123,19 +123,4 @@ LabelledCloud withDepth(const LabelledCloud& cloud, const cv::Mat& depth_m,
   return out;
 }
 
-LabelledCloud everyNth(const LabelledCloud& cloud, double step) {
-  if (!(step >= 1.0)) throw std::invalid_argument("everyNth: the step must be at least 1");
-  LabelledCloud out =
-      withoutPoints(cloud, std::size_t(std::ceil(double(cloud.size()) / step)));
-  for (std::size_t k = 0;; ++k) {
-    const auto i = std::size_t(std::floor(double(k) * step));
-    if (i >= cloud.size()) break;
-    out.points.push_back(cloud.points[i]);
-    out.labels.push_back(cloud.labels[i]);
-    out.pixels.push_back(cloud.pixels[i]);
-    out.rgb.push_back(cloud.rgb[i]);
-  }
-  return out;
-}
-
 }  // namespace acvo

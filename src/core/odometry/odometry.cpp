@@ -28,7 +28,6 @@ struct Odometry::Registration {
   // The cloud registered: the frame's own, or its cloud with the depth moved to the colour's
   // time again at the velocity this registration's coarse levels found (retimedCloud).
   std::shared_ptr<PreparedCloud> moving;
-  cv::Mat moved_depth;  // the depth `moving` took its points from, where moved again
   SolverResult solver;
   Judgement judgement;
   Matrix6d covariance = lostCovariance();  // of the motion, when tracked
@@ -255,7 +254,7 @@ Odometry::Registration Odometry::registerTo(const Tracked& reference,
     }
     // The velocity over the delay: this frame's own, as the coarse levels found it.
     const Vector6d velocity = logSE3(frameMotion(coarse.transform)) / r.interval;
-    if (auto again = retimedCloud(*current, frame, velocity, r, &reg.moved_depth)) {
+    if (auto again = retimedCloud(*current, frame, velocity, r)) {
       reg.moving = std::move(again);
     }
     reg.solver = combinedStages(
@@ -460,7 +459,7 @@ bool Odometry::retimes(const OdometryResult& r) const {
 std::shared_ptr<PreparedCloud> Odometry::retimedCloud(const PreparedCloud& current,
                                                       const Frame& frame,
                                                       const Vector6d& velocity,
-                                                      OdometryResult& r, cv::Mat* depth) const {
+                                                      OdometryResult& r) const {
   const auto t0 = Clock::now();
   // What the cloud was built with: the last frame-to-frame motion over the delay, or nothing.
   const Eigen::Isometry3d before =
@@ -473,8 +472,8 @@ std::shared_ptr<PreparedCloud> Odometry::retimedCloud(const PreparedCloud& curre
   }
   // The pixels stay those selected: the colour image has not changed, only where the depth
   // puts their points.
-  *depth = depthSeenFrom(frame.depth, frame.camera, moved);
-  LabelledCloud cloud = withDepth(current.cloud, *depth, params_.selection);
+  LabelledCloud cloud =
+      withDepth(current.cloud, depthSeenFrom(frame.depth, frame.camera, moved), params_.selection);
   auto out = engine_->prepare(std::move(cloud), current.reference);
   r.ms_cloud += msSince(t0);
   return out;
@@ -487,24 +486,13 @@ std::shared_ptr<PreparedCloud> Odometry::buildCloud(const Frame& frame, Odometry
   // With keyframes, only when it becomes one (asReference).
   const bool every_frame_a_reference = params_.odometry.reference == Reference::kPreviousFrame;
   const Frame at_colour_time = depthAtColourTime(frame, r);
-  const double density = params_.selection.reference_density;
-  selected_.reset();
   arena_->arena.execute([&] {
-    SelectionParams selection = params_.selection;
-    if (density > 1.0) {
-      selection.target_points = int(std::lround(selection.target_points * density));
-    }
-    LabelledCloud cloud = buildLabelledCloud(at_colour_time, selection, &r.cloud_stats);
+    LabelledCloud cloud = buildLabelledCloud(at_colour_time, params_.selection, &r.cloud_stats);
     // The motion while the shutter was open.
     if (const double exposure = params_.coarse_to_fine.exposure_time; exposure > 0.0) {
       cloud.blur_motion = motionOver(exposure).value_or(Eigen::Isometry3d::Identity());
     }
-    if (density > 1.0) {
-      selected_ = std::move(cloud);
-      cloud = everyNth(*selected_, density);
-    }
-    // A share's search grids would not be used: the whole selection becomes the reference.
-    current = engine_->prepare(std::move(cloud), every_frame_a_reference && !selected_);
+    current = engine_->prepare(std::move(cloud), every_frame_a_reference);
   });
   r.ms_cloud = msSince(t0);
   r.moving_points = current->size();
@@ -514,18 +502,7 @@ std::shared_ptr<PreparedCloud> Odometry::buildCloud(const Frame& frame, Odometry
 }
 
 std::shared_ptr<PreparedCloud> Odometry::asReferenceCloud(
-    OdometryResult& r, const std::shared_ptr<PreparedCloud>& registered, const cv::Mat& depth) {
-  std::shared_ptr<PreparedCloud> cloud = registered;
-  if (selected_) {
-    const auto t0 = Clock::now();
-    LabelledCloud all = depth.empty() ? std::move(*selected_)
-                                      : withDepth(*selected_, depth, params_.selection);
-    selected_.reset();
-    arena_->arena.execute([&] { cloud = engine_->prepare(std::move(all), false); });
-    const double ms = msSince(t0);
-    r.ms_prepare += ms;
-    r.ms_cloud += ms;
-  }
+    OdometryResult& r, const std::shared_ptr<PreparedCloud>& cloud) {
   asReference(r, *cloud);
   return cloud;
 }
@@ -722,7 +699,7 @@ void Odometry::tracked(OdometryResult& r, const Registration& reg,
       takesKeyframe(reg.judgement, reg.solver, params_.odometry)) {
     frame.to_keyframe = Eigen::Isometry3d::Identity();
     frame.to_keyframe_covariance = Matrix6d::Zero();
-    frame.cloud = asReferenceCloud(r, current, reg.moved_depth);
+    frame.cloud = asReferenceCloud(r, current);
     keyframe_ = frame;
     r.new_keyframe = true;
   }
