@@ -24,13 +24,10 @@
 // same in all quarters of the image but one (min_quarter_gain: a person's colour late on its
 // silhouette fits a camera in one part of the image only); most frames' own best camera near
 // it (min_agreement); and the focal ratio alone that fits best near it (the default
-// resampling's, best_ratio) also min_offset from 1 and not at the grid's ends. Once unregistered, the frames' evidence is
-// searched finer about that camera (findColourCamera: rendered rooms at 0.897 and 2.5 cm, found
-// within 1 cm and 0.01; docs/accuracy.md, fifteenth round). Colour and depth of two instants
-// (free-running streams) misalign by the motion between them: Odometry, which runs the check,
-// gives it the depth as it registered it (depthAsRegistered, odometry.hpp), and resamples an
-// unregistered camera's colour by the ratio found, or by the camera found where asked
-// (withColourResampled, below; OdometryParams::resample_colour_baseline).
+// resampling's, best_ratio) also min_offset from 1 and not at the grid's ends. Colour and depth
+// of two instants (free-running streams) misalign by the motion between them: Odometry, which
+// runs the check, gives it the depth as it registered it (depthAsRegistered, odometry.hpp), and
+// resamples an unregistered camera's colour by the ratio found (withColourResampled, below).
 #pragma once
 
 #include <array>
@@ -85,10 +82,6 @@ class ColourDepthCheck {
     // The colour focal length over the depth's that fits best alone (no baseline, every edge
     // pixel) within agreement_within of grid_ratio: the default resampling's.
     double best_ratio = 1.0;
-    // The colour camera found once unregistered (findColourCamera): its focal ratio and its
-    // centre along x from the depth camera's, in m (best_ratio and 0 otherwise).
-    double camera_ratio = 1.0;
-    double baseline = 0.0;
     // The camera of the search's grid (focal ratio by 0.01, centre by kBaselineStep) that fits
     // best, and its score over the score of a camera in the depth camera's place.
     double grid_ratio = 1.0;
@@ -148,18 +141,8 @@ class ColourDepthCheck {
   int baselines() const;           // the camera grid's centres: -max_baseline ... max_baseline
   double baselineAt(int j) const;
   std::size_t cameraIndex(int i, int j) const;  // ratio i, centre j in camera_sum_
-  // Searches the kept evidence for the colour camera (Verdict::camera_ratio, baseline).
-  void findColourCamera();
-
-  // A counted frame's evidence, kept until the verdict for the camera search.
-  struct Evidence {
-    cv::Mat strength;
-    std::vector<EdgePoint> edges;
-  };
 
   Options options_;
-  std::vector<Evidence> evidence_;
-  Camera camera_;
   std::array<double, kRatios> sum_{};
   std::vector<double> camera_sum_;  // per camera of the grid (cameraIndex)
   std::array<std::vector<double>, 4> quarter_sum_;  // the same, by the image's quarters
@@ -171,12 +154,9 @@ class ColourDepthCheck {
 std::string toString(ColourDepthCheck::State state);
 
 // The frame as a colour camera in the depth camera's place would have seen it, `ratio` being the
-// colour camera's focal length over the depth's and `baseline` its centre along x in metres
-// (Verdict::best_ratio, or Verdict::camera_ratio and baseline): the colour at each pixel (u, v)
-// with depth z taken from (cx + ratio (u - cx) - ratio fx baseline / z, cy + ratio (v - cy))
-// (bilinear; a pixel without depth as if at the frame's median depth), the depth cleared where
-// that falls outside the colour image (no colour was seen there). A point hidden from the colour camera by a nearer
-// one takes the nearer one's colour, as on any registered camera.
-Frame withColourResampled(const Frame& frame, double ratio, double baseline = 0.0);
+// colour camera's focal length over the depth's (Verdict::best_ratio): the colour at each pixel
+// (u, v) taken from (cx + ratio (u - cx), cy + ratio (v - cy)) (bilinear), the depth cleared where
+// that falls outside the colour image (no colour was seen there).
+Frame withColourResampled(const Frame& frame, double ratio);
 
 }  // namespace acvo

@@ -271,8 +271,7 @@ class Odometry {
   // Whether depth and colour look registered, from every ColourDepthCheck::kFrameStep-th frame
   // (as registered: depthAsRegistered) until it decides; and the focal ratio each frame's
   // colour is resampled by since (an unregistered verdict, resample_unregistered_colour), if
-  // any (with resample_colour_baseline, the camera's ratio, and its baseline
-  // colourCheck().verdict().baseline). Neither changes with reset(): they concern the camera.
+  // any. Neither changes with reset(): they concern the camera.
   const ColourDepthCheck& colourCheck() const { return colour_check_; }
   std::optional<double> colourResampling() const { return colour_ratio_; }
   // The check's verdict for a log (ColourDepthCheck::describe), and what is done about it.
@@ -393,8 +392,7 @@ class Odometry {
   bool guess_unknown_ = false;
   std::uint64_t frames_ = 0;  // frames numbered so far
   ColourDepthCheck colour_check_;
-  // Each frame's colour is resampled by it (colourResampling), and by the verdict's baseline with
-  // resample_colour_baseline (resampled()).
+  // Each frame's colour is resampled by it (colourResampling).
   std::optional<double> colour_ratio_;
   struct Arena;               // the thread pool the solver runs in (odometry.threads)
   std::unique_ptr<Arena> arena_;

@@ -173,14 +173,6 @@ struct OdometryParams {
   // the surfaces with the motion (docs/accuracy.md, sixth and fourteenth rounds). Off: the
   // colour is used as it comes, with the check's warning.
   bool resample_unregistered_colour = true;
-  // Resample by the colour camera the check found (Verdict::camera_ratio and baseline: its
-  // centre along x, the colour at depth z shifted by ratio fx baseline / z) instead of the focal
-  // ratio alone. Off by default: on five rendered rooms with 7-Scenes' two cameras it registers
-  // the colour better (u32 0.0116 -> 0.0036 m/s, the others 1.0-1.4x), on the real 7-Scenes
-  // kitchen it measured worse (0.0321 -> 0.0380 m/s; every 2nd frame 0.0301 -> 0.0347), whose
-  // colour and depth come from free-running streams through real lenses (docs/accuracy.md,
-  // fifteenth round). On: for two synchronised cameras known to be pinholes (a simulator's).
-  bool resample_colour_baseline = false;
   // Where the registered motion misses the motion guess (constant velocity) by more than
   // kSecondStartTranslation or kSecondStartRotation in one frame (odometry.hpp; more than a
   // hand-held camera's velocity changes in a frame: up to 20 mm on the real folders), the
@@ -291,7 +283,6 @@ void visitParams(Params_& p, Visitor&& visit) {
   visit("odometry", "lost_angular_speed", p.odometry.lost_angular_speed);
   visit("odometry", "sync_depth", p.odometry.sync_depth);
   visit("odometry", "resample_unregistered_colour", p.odometry.resample_unregistered_colour);
-  visit("odometry", "resample_colour_baseline", p.odometry.resample_colour_baseline);
   visit("odometry", "second_start", p.odometry.second_start);
 }
 

@@ -175,7 +175,6 @@ acvo::AcvoConfig toConfig(const acvo::Params& params, LostOdom lost_odom) {
   c.initial_guess = acvo::toString(params.odometry.initial_guess);
   c.sync_depth = params.odometry.sync_depth;
   c.resample_unregistered_colour = params.odometry.resample_unregistered_colour;
-  c.resample_colour_baseline = params.odometry.resample_colour_baseline;
   c.second_start = params.odometry.second_start;
   c.lost_odom = toString(lost_odom);
   return c;
@@ -206,7 +205,6 @@ acvo::Params fromConfig(const acvo::AcvoConfig& config, acvo::Params base) {
   acvo::fromString(config.initial_guess, base.odometry.initial_guess);
   base.odometry.sync_depth = config.sync_depth;
   base.odometry.resample_unregistered_colour = config.resample_unregistered_colour;
-  base.odometry.resample_colour_baseline = config.resample_colour_baseline;
   base.odometry.second_start = config.second_start;
   return base;
 }

@@ -450,39 +450,6 @@ TEST(Odometry, ColourFromASecondCameraIsResampledFromTheVerdictOn) {
   EXPECT_FALSE(plain.colourResampling());
 }
 
-// With resample_colour_baseline, a colour camera 2.5 cm beside the depth camera is resampled by
-// the camera the check found: its ratio and baseline, from the keyframe of the verdict on.
-TEST(Odometry, ColourResampledByTheCameraFoundWhenAsked) {
-  synth::SequenceOptions o;
-  o.frames = 12;
-  o.noise = false;
-  o.colour_focal_ratio = 0.897;
-  o.colour_baseline = 0.025;
-  const synth::SynthSequence seq(o);
-  Params params;
-  params.odometry.resample_colour_baseline = true;
-  Odometry odo(params);
-  odo.reset(seq.poses()[0]);
-  bool checked = false;
-  for (int i = 0; i < seq.size(); ++i) {
-    const Frame frame = seq.frame(i).toFrame();
-    if (!odo.process(frame).colour_verdict_now) continue;
-    const ColourDepthCheck::Verdict& v = odo.colourCheck().verdict();
-    ASSERT_EQ(v.state, ColourDepthCheck::State::kUnregistered);
-    ASSERT_TRUE(odo.colourResampling());
-    EXPECT_EQ(*odo.colourResampling(), v.camera_ratio);
-    EXPECT_NEAR(v.baseline, 0.025, 0.01);  // measured 0.023
-    const Frame resampled = withColourResampled(frame, v.camera_ratio, v.baseline);
-    const LabelledCloud& key = *odo.keyframeCloud();
-    ASSERT_FALSE(key.pixels.empty());
-    const cv::Point p = key.pixels[key.pixels.size() / 2];
-    EXPECT_EQ(key.gray.at<std::uint8_t>(p), grayImage(resampled).at<std::uint8_t>(p));
-    EXPECT_NE(odo.describeColour().find("resample_colour_baseline"), std::string::npos);
-    checked = true;
-  }
-  EXPECT_TRUE(checked);
-}
-
 // Once the colour is resampled, the last level is led by the depth (CoarseToFineParams::
 // depth_led): the dense plane term, off on noise in blobs as a real Kinect's, then counts fully.
 // A registered camera with the same noise keeps it off.

@@ -124,15 +124,15 @@ const ColourDepthCheck::Verdict& ColourDepthCheck::add(const Frame& frame) {
   for (const auto& [u, v] : pixels) {
     edges.push_back({float(u), float(v), frame.depth.at<float>(v, u)});
   }
-  Evidence evidence;
-  evidence.strength = edgeStrength(grayImage(frame));
-  const auto s = ratioScores(evidence.strength, frame.camera, edges);
+  const cv::Mat strength = edgeStrength(grayImage(frame));
+  const auto s = ratioScores(strength, frame.camera, edges);
   if (s[kRatios / 2] <= 0.0) return verdict_;  // no colour edges (a blank colour image)
-  // The evidence for the grid and the camera search: the edge strength and the edges, thinned to
-  // every k-th (k = edges / max_edges_per_frame, rounded down: under twice that many, all).
+  // The grid's evidence: the edges thinned to every k-th (k = edges / max_edges_per_frame,
+  // rounded down: under twice that many, all).
   const std::size_t step = std::max<std::size_t>(
       1, edges.size() / std::size_t(std::max(1, options_.max_edges_per_frame)));
-  for (std::size_t i = 0; i < edges.size(); i += step) evidence.edges.push_back(edges[i]);
+  std::vector<EdgePoint> thinned;
+  for (std::size_t i = 0; i < edges.size(); i += step) thinned.push_back(edges[i]);
   // Every camera of the grid on those edges (41 x 13 cameras), in all and by the image's quarters
   // about the principal point. A quarter whose edges a camera does not see at all adds nothing
   // for it, which errs towards "registered".
@@ -145,7 +145,7 @@ const ColourDepthCheck::Verdict& ColourDepthCheck::add(const Frame& frame) {
   for (int i = 0; i < kRatios; ++i) {
     for (int j = 0; j < nb; ++j) {
       const Quarters q =
-          quarterScores(evidence.strength, frame.camera, evidence.edges, ratioAt(i), baselineAt(j));
+          quarterScores(strength, frame.camera, thinned, ratioAt(i), baselineAt(j));
       double sum = 0.0;
       int n = 0;
       for (std::size_t k = 0; k < 4; ++k) {
@@ -169,18 +169,11 @@ const ColourDepthCheck::Verdict& ColourDepthCheck::add(const Frame& frame) {
     camera_sum_[c] += cameras[c];
     for (std::size_t k = 0; k < 4; ++k) quarter_sum_[k][c] += quarters[k][c];
   }
-  for (const EdgePoint& e : evidence.edges) {
+  for (const EdgePoint& e : thinned) {
     ++quarter_edges_[std::size_t(quarterOf(frame.camera, e))];
   }
   frame_camera_best_.push_back(frame_best);
-  evidence_.push_back(std::move(evidence));
-  camera_ = frame.camera;
-  if (verdict_.frames >= options_.frames_needed) {
-    decide();
-    if (verdict_.state == State::kUnregistered) findColourCamera();
-    evidence_.clear();
-    evidence_.shrink_to_fit();
-  }
+  if (verdict_.frames >= options_.frames_needed) decide();
   return verdict_;
 }
 
@@ -243,39 +236,7 @@ void ColourDepthCheck::decide() {
                             verdict_.agreement >= options_.min_agreement &&
                             verdict_.quarter_gain >= options_.min_quarter_gain;
   verdict_.state = unregistered ? State::kUnregistered : State::kRegistered;
-  verdict_.best_ratio = verdict_.camera_ratio = ratioAt(alone);
-  if (unregistered) verdict_.camera_ratio = verdict_.grid_ratio;  // findColourCamera refines it
-}
-
-void ColourDepthCheck::findColourCamera() {
-  // The frames' mean score of one colour camera; frames count alike, as in the ratio search.
-  auto total = [&](double ratio, double baseline) {
-    double sum = 0.0;
-    for (const Evidence& e : evidence_) sum += score(e.strength, camera_, e.edges, ratio, baseline);
-    return sum;
-  };
-  // A grid (focal ratio within 0.03 of the one found, by 0.005; baseline by 5 mm), then a finer
-  // one about its best (by 0.001 and 1 mm): about 400 cameras in all.
-  auto search = [&](double ratio0, double ratio_reach, double ratio_step, double baseline0,
-                    double baseline_reach, double baseline_step) {
-    double best = -1.0;
-    const int nr = int(std::lround(ratio_reach / ratio_step));
-    const int nb = int(std::lround(baseline_reach / baseline_step));
-    for (int i = -nr; i <= nr; ++i) {
-      for (int j = -nb; j <= nb; ++j) {
-        const double ratio = ratio0 + i * ratio_step, baseline = baseline0 + j * baseline_step;
-        if (std::abs(baseline) > options_.max_baseline + 1e-9) continue;
-        const double s = total(ratio, baseline);
-        if (s > best) {
-          best = s;
-          verdict_.camera_ratio = ratio;
-          verdict_.baseline = baseline;
-        }
-      }
-    }
-  };
-  search(verdict_.camera_ratio, 0.03, 0.005, 0.0, options_.max_baseline, 0.005);
-  search(verdict_.camera_ratio, 0.004, 0.001, verdict_.baseline, 0.004, 0.001);
+  verdict_.best_ratio = ratioAt(alone);
 }
 
 std::string ColourDepthCheck::describe() const {
@@ -307,12 +268,12 @@ std::string ColourDepthCheck::describe() const {
       std::snprintf(text, sizeof text,
                     "the depth image does not look registered to the colour image: the colour "
                     "edges fit the depth edges best with the colour focal length %.2f times the "
-                    "depth's (%d frames; as a camera beside the depth camera: %.3f times, its "
-                    "centre %.1f cm along x, at least %.1fx the score as given). acvo needs depth "
+                    "depth's (%d frames; as a camera beside the depth camera: %.2f times, its "
+                    "centre %.0f cm along x, %.1fx the score as given). acvo needs depth "
                     "registered pixel for pixel to the colour camera: use the driver's "
                     "depth_registered image (openni2_launch depth_registration:=true, "
                     "realsense2_camera align_depth:=true) or depth_image_proc/register",
-                    v.best_ratio, v.frames, v.camera_ratio, 100.0 * v.baseline, v.gain);
+                    v.best_ratio, v.frames, v.grid_ratio, 100.0 * v.grid_baseline, v.gain);
       break;
   }
   return text;
@@ -330,73 +291,32 @@ std::string toString(ColourDepthCheck::State state) {
   return "undecided";
 }
 
-namespace {
-
-// The median of the frame's valid depth, from every 4th pixel of every 4th row (0 if none).
-double medianDepth(const cv::Mat& depth) {
-  std::vector<float> values;
-  for (int v = 0; v < depth.rows; v += 4) {
-    const float* d = depth.ptr<float>(v);
-    for (int u = 0; u < depth.cols; u += 4) {
-      if (d[u] > 0.0f && std::isfinite(d[u])) values.push_back(d[u]);
-    }
-  }
-  if (values.empty()) return 0.0;
-  auto middle = values.begin() + std::ptrdiff_t(values.size() / 2);
-  std::nth_element(values.begin(), middle, values.end());
-  return *middle;
-}
-
-}  // namespace
-
-Frame withColourResampled(const Frame& frame, double ratio, double baseline) {
-  if (frame.color.empty() || !(ratio > 0.0) || (ratio == 1.0 && baseline == 0.0)) return frame;
+Frame withColourResampled(const Frame& frame, double ratio) {
+  if (frame.color.empty() || !(ratio > 0.0) || ratio == 1.0) return frame;
   const Camera& c = frame.camera;
   Frame out = frame;
   out.color = cv::Mat();  // a new image: the frame's own is shared, not written
   const cv::Mat& colour = frame.color;
-  const double fill_depth = baseline != 0.0 ? medianDepth(frame.depth) : 0.0;
-  if (baseline == 0.0 || !(fill_depth > 0.0)) {
-    // Scaling about the principal point: cv::warpAffine with the map from each output pixel to
-    // where it is read.
-    const cv::Matx23d to_colour(ratio, 0.0, c.cx * (1.0 - ratio), 0.0, ratio, c.cy * (1.0 - ratio));
-    cv::warpAffine(colour, out.color, to_colour, colour.size(),
-                   cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_REPLICATE);
-    if (ratio > 1.0 && !frame.depth.empty()) {
-      // The colour image's reach is a rectangle: the columns and rows it covers, once each.
-      std::vector<bool> seen_u(std::size_t(frame.depth.cols));
-      for (int u = 0; u < frame.depth.cols; ++u) {
-        seen_u[std::size_t(u)] = inside(colour, c.cx + ratio * (u - c.cx), 0.0);
-      }
-      out.depth = frame.depth.clone();
-      for (int v = 0; v < out.depth.rows; ++v) {
-        const bool seen_v = inside(colour, 0.0, c.cy + ratio * (v - c.cy));
-        auto* d = out.depth.ptr<float>(v);
-        for (int u = 0; u < out.depth.cols; ++u) {
-          if (!seen_v || !seen_u[std::size_t(u)]) d[u] = 0.0f;
-        }
+  // Scaling about the principal point: cv::warpAffine with the map from each output pixel to
+  // where it is read.
+  const cv::Matx23d to_colour(ratio, 0.0, c.cx * (1.0 - ratio), 0.0, ratio, c.cy * (1.0 - ratio));
+  cv::warpAffine(colour, out.color, to_colour, colour.size(), cv::INTER_LINEAR | cv::WARP_INVERSE_MAP,
+                 cv::BORDER_REPLICATE);
+  if (ratio > 1.0 && !frame.depth.empty()) {
+    // The colour image's reach is a rectangle: the columns and rows it covers, once each.
+    std::vector<bool> seen_u(std::size_t(frame.depth.cols));
+    for (int u = 0; u < frame.depth.cols; ++u) {
+      seen_u[std::size_t(u)] = inside(colour, c.cx + ratio * (u - c.cx), 0.0);
+    }
+    out.depth = frame.depth.clone();
+    for (int v = 0; v < out.depth.rows; ++v) {
+      const bool seen_v = inside(colour, 0.0, c.cy + ratio * (v - c.cy));
+      auto* d = out.depth.ptr<float>(v);
+      for (int u = 0; u < out.depth.cols; ++u) {
+        if (!seen_v || !seen_u[std::size_t(u)]) d[u] = 0.0f;
       }
     }
-    return out;
   }
-  // With a baseline each pixel's source depends on its depth: a map per pixel for cv::remap.
-  const double shift = ratio * c.fx * baseline;
-  cv::Mat map_u(frame.depth.size(), CV_32FC1), map_v(frame.depth.size(), CV_32FC1);
-  out.depth = frame.depth.clone();
-  for (int v = 0; v < out.depth.rows; ++v) {
-    float* d = out.depth.ptr<float>(v);
-    float* mu = map_u.ptr<float>(v);
-    float* mv = map_v.ptr<float>(v);
-    const double y = c.cy + ratio * (v - c.cy);
-    for (int u = 0; u < out.depth.cols; ++u) {
-      const bool has_depth = d[u] > 0.0f && std::isfinite(d[u]);
-      const double x = c.cx + ratio * (u - c.cx) - shift / (has_depth ? d[u] : fill_depth);
-      mu[u] = float(x);
-      mv[u] = float(y);
-      if (has_depth && !inside(colour, x, y)) d[u] = 0.0f;  // the colour camera saw nothing
-    }
-  }
-  cv::remap(colour, out.color, map_u, map_v, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
   return out;
 }
 

@@ -327,9 +327,7 @@ void Odometry::checkColour(const Frame& frame, OdometryResult& r) {
 }
 
 Frame Odometry::resampled(const Frame& frame) const {
-  const double baseline =
-      params_.odometry.resample_colour_baseline ? colour_check_.verdict().baseline : 0.0;
-  return withColourResampled(frame, *colour_ratio_, baseline);
+  return withColourResampled(frame, *colour_ratio_);
 }
 
 void Odometry::actOnColourVerdict() {
@@ -338,13 +336,12 @@ void Odometry::actOnColourVerdict() {
   colour_ratio_.reset();
   if (v.state == ColourDepthCheck::State::kUnregistered &&
       params_.odometry.resample_unregistered_colour) {
-    colour_ratio_ = params_.odometry.resample_colour_baseline ? v.camera_ratio : v.best_ratio;
+    colour_ratio_ = v.best_ratio;
   }
   if (had == colour_ratio_.has_value()) return;
   // Resampled by the focal ratio, a point's colour is still off by the cameras' baseline (a few
-  // pixels), and by the baseline found too, by that estimate's error (about 5 mm, a pixel or two
-  // at 2 m): near enough for the labels and the selection, too far for grey values compared at
-  // a sub-pixel (docs/accuracy.md, fourteenth and fifteenth rounds). Without the grey values,
+  // pixels): near enough for the labels and the selection, too far for grey values compared at
+  // a sub-pixel (docs/accuracy.md, fourteenth round). Without the grey values,
   // nothing corrects the kernel's pull towards no motion on real depth: the last level is led
   // by the depth's plane terms (CoarseToFineParams::depth_led; twenty-ninth round). A keyframe
   // prepared by the other engine serves either (the dense term waits for a keyframe with a depth
@@ -365,13 +362,9 @@ void Odometry::takeColourCheck(const ColourDepthCheck& check) {
 std::string Odometry::describeColour() const {
   std::string text = colour_check_.describe();
   if (colour_ratio_) {
-    text += params_.odometry.resample_colour_baseline
-                ? ". Meanwhile each frame's colour is resampled to the depth camera by that "
-                  "camera, and registered without the photometric term, led by the depth "
-                  "(odometry/resample_unregistered_colour, resample_colour_baseline)"
-                : ". Meanwhile each frame's colour is resampled by that ratio, and registered "
-                  "without the photometric term, led by the depth "
-                  "(odometry/resample_unregistered_colour)";
+    text += ". Meanwhile each frame's colour is resampled by that ratio, and registered "
+            "without the photometric term, led by the depth "
+            "(odometry/resample_unregistered_colour)";
   }
   return text;
 }
