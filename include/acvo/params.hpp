@@ -16,6 +16,8 @@ enum class EllPolicy { kAdaptive, kFixedSchedule };
 enum class EllUpdate { kDescent, kReference };
 enum class InitialGuess { kConstantVelocity, kIdentity };
 enum class Reference { kKeyframe, kPreviousFrame };
+enum class SyncDepth { kNone, kLastMotion, kOwnMotion };
+enum class UnregisteredColour { kAsGiven, kResample, kResampleDepthLed };
 
 struct SelectionParams {
   int target_points = 4000;    // semi-dense cloud size the selector aims at (paper: 3000)
@@ -66,6 +68,20 @@ struct CoarseToFineParams {
   // none as the depth's residuals reach the depth noise above, so it counts where depth is
   // better than a Kinect's). Off: the kernel alone, as before them.
   bool photometric = true;
+  // The photometric term in both directions: also each reference point's grey value against the
+  // moving image where it lands (counted as one term with the forward direction). Off: forward.
+  bool reverse_photometric = true;
+  // The grey images are smoothed by a Gaussian of this std (px) before the photometric term
+  // samples them: rendered images, sampled without anti-aliasing, have intensity steps no
+  // sub-pixel shift matches; a real camera's optics blur as much. 0: as they are.
+  double grey_smoothing = 0.7;
+  // A grey residual's variance is its learned scale squared plus its squared gradient times this
+  // (px^2): the variance of where an intensity edge lies, a pixel's quantisation (DSO's
+  // gradient-dependent weight). 0: the learned scale alone.
+  double edge_variance = 1.0 / 12.0;
+  // Every direct term's residuals get Tukey's biweight to this many standard deviations: beyond
+  // them (a person crossing the view, an occlusion) a residual no longer pulls. 0: least squares.
+  double tukey_sigmas = 8.0;
   bool point_to_plane = true;
   // ... and the plane distances of the moving depth on a grid of pixels, each point a window's
   // mean (dense_point_to_plane; direct_terms.hpp, denseGrid): ICP's evidence, used only where
@@ -73,6 +89,9 @@ struct CoarseToFineParams {
   // depth is exact, and only on depth taken at the colour's instant (Frame::depth_stamp:
   // a delay moves the depth by an estimated motion, whose error it would follow).
   bool dense_point_to_plane = true;
+  // Pixels between the dense term's points where the depth is exact (its measured noise under a
+  // tenth of depth_noise: a simulator's); every 10th pixel elsewhere.
+  int exact_depth_grid_stride = 5;
   // The last level led by the depth: both point-to-plane terms at the weight their own learned
   // scales give (no fade by depth_noise, the dense term whatever its independence) and the
   // kernel's quadratic at kDepthLedKernelShare of its weight. The kernel's optimum is pulled
@@ -161,18 +180,20 @@ struct OdometryParams {
   // (a hand-held camera: 0.35 m/s and up to 100 deg/s on TUM fr3/teddy).
   double lost_speed = 1.0;           // m/s
   double lost_angular_speed = 90.0;  // deg/s
-  // Colour and depth taken at different times (Frame::depth_stamp): the depth is moved to the
-  // colour's time by the last frame-to-frame motion (constant velocity), then again at the
-  // frame's own velocity as the registration's coarse levels find it, so that each point's
-  // colour and position are of one instant. Off: the two are paired as they come.
-  bool sync_depth = true;
+  // Colour and depth taken at different times (Frame::depth_stamp), so that each point's colour
+  // and position are of one instant: own_motion moves the depth to the colour's time by the
+  // last frame-to-frame motion (constant velocity), then again, between the registration's
+  // coarse levels and its finest, at the frame's own velocity as the coarse levels found it;
+  // last_motion only the first; none pairs the two as they come.
+  SyncDepth sync_depth = SyncDepth::kOwnMotion;
   // Once the colour check (ColourDepthCheck) finds the depth not registered to the colour (a
-  // second camera's colour, 7-Scenes'), each frame's colour is resampled to the depth camera's
-  // focal length, by the ratio the check found (withColourResampled): a colour left off its
-  // points puts the points chosen at its edges where the texture appears, which slides along
-  // the surfaces with the motion (docs/accuracy.md, sixth and fourteenth rounds). Off: the
-  // colour is used as it comes, with the check's warning.
-  bool resample_unregistered_colour = true;
+  // second camera's colour, 7-Scenes'): resample resamples each frame's colour to the depth
+  // camera's focal length by the ratio the check found (withColourResampled), so that the points
+  // chosen at its edges lie where the texture is; resample_depth_led also registers it without
+  // the photometric term (a point's colour is still off by the cameras' baseline, a few pixels),
+  // the last level led by the depth (CoarseToFineParams::depth_led); as_given uses the colour as
+  // it comes, with the check's warning.
+  UnregisteredColour unregistered_colour = UnregisteredColour::kResampleDepthLed;
   // Where the registered motion misses the motion guess (constant velocity) by more than
   // kSecondStartTranslation or kSecondStartRotation in one frame (odometry.hpp; more than a
   // hand-held camera's velocity changes in a frame: up to 20 mm on the real folders), the
@@ -190,6 +211,19 @@ struct OdometryParams {
   // kRestMargin times as many of the image's pixels agree with it (a person in view from the
   // start; twenty-third round). Off: the paper's single start.
   bool second_start = true;
+  // Parts of the second start, each on its own (all need second_start):
+  //  - second_start_check: a miss under the limits but unusual for this camera (more than
+  //    kSecondStartCheckSigmas times its recent velocity changes) is run again too;
+  //  - second_start_memory: within kSecondStartMemory of a kept second start the first must
+  //    score kSecondStartKeptMargin times the second's to be kept (a person pulling lately);
+  //  - turn_start: a turn and a translation that both miss, scoring low against the last frame,
+  //    are run again from the turn with the guess's translation (a fast turn taken partly for a
+  //    sideways move);
+  //  - rest_start: with no motion known, the points left disagreeing are registered alone.
+  bool second_start_check = true;
+  bool second_start_memory = true;
+  bool turn_start = true;
+  bool rest_start = true;
 };
 
 struct Params {
@@ -205,12 +239,16 @@ std::string toString(EllPolicy v);
 std::string toString(EllUpdate v);
 std::string toString(InitialGuess v);
 std::string toString(Reference v);
+std::string toString(SyncDepth v);
+std::string toString(UnregisteredColour v);
 // Throw std::invalid_argument listing the accepted values.
 void fromString(const std::string& s, Engine& v);
 void fromString(const std::string& s, EllPolicy& v);
 void fromString(const std::string& s, EllUpdate& v);
 void fromString(const std::string& s, InitialGuess& v);
 void fromString(const std::string& s, Reference& v);
+void fromString(const std::string& s, SyncDepth& v);
+void fromString(const std::string& s, UnregisteredColour& v);
 
 // Calls visit(section, name, field) for every parameter; field is int&, double&, bool& or one
 // of the enums above. Sections: "selection", "registration", "coarse_to_fine", "paper",
@@ -238,8 +276,13 @@ void visitParams(Params_& p, Visitor&& visit) {
   visit("coarse_to_fine", "level_eps", c.level_eps);
   visit("coarse_to_fine", "level_acceleration", c.level_acceleration);
   visit("coarse_to_fine", "photometric", c.photometric);
+  visit("coarse_to_fine", "reverse_photometric", c.reverse_photometric);
+  visit("coarse_to_fine", "grey_smoothing", c.grey_smoothing);
+  visit("coarse_to_fine", "edge_variance", c.edge_variance);
+  visit("coarse_to_fine", "tukey_sigmas", c.tukey_sigmas);
   visit("coarse_to_fine", "point_to_plane", c.point_to_plane);
   visit("coarse_to_fine", "dense_point_to_plane", c.dense_point_to_plane);
+  visit("coarse_to_fine", "exact_depth_grid_stride", c.exact_depth_grid_stride);
   visit("coarse_to_fine", "depth_led", c.depth_led);
   visit("coarse_to_fine", "photometric_gain", c.photometric_gain);
   visit("coarse_to_fine", "photometric_vignetting", c.photometric_vignetting);
@@ -282,8 +325,12 @@ void visitParams(Params_& p, Visitor&& visit) {
   visit("odometry", "lost_speed", p.odometry.lost_speed);
   visit("odometry", "lost_angular_speed", p.odometry.lost_angular_speed);
   visit("odometry", "sync_depth", p.odometry.sync_depth);
-  visit("odometry", "resample_unregistered_colour", p.odometry.resample_unregistered_colour);
+  visit("odometry", "unregistered_colour", p.odometry.unregistered_colour);
   visit("odometry", "second_start", p.odometry.second_start);
+  visit("odometry", "second_start_check", p.odometry.second_start_check);
+  visit("odometry", "second_start_memory", p.odometry.second_start_memory);
+  visit("odometry", "turn_start", p.odometry.turn_start);
+  visit("odometry", "rest_start", p.odometry.rest_start);
 }
 
 // The paper's A-CVO as the authors' code runs it (config/paper.yaml; docs/method.md §4 says

@@ -46,6 +46,22 @@ struct EnumNames<Reference> {
       {Reference::kKeyframe, "keyframe"}, {Reference::kPreviousFrame, "previous_frame"}};
 };
 
+template <>
+struct EnumNames<SyncDepth> {
+  static constexpr std::pair<SyncDepth, const char*> table[] = {
+      {SyncDepth::kNone, "none"},
+      {SyncDepth::kLastMotion, "last_motion"},
+      {SyncDepth::kOwnMotion, "own_motion"}};
+};
+
+template <>
+struct EnumNames<UnregisteredColour> {
+  static constexpr std::pair<UnregisteredColour, const char*> table[] = {
+      {UnregisteredColour::kAsGiven, "as_given"},
+      {UnregisteredColour::kResample, "resample"},
+      {UnregisteredColour::kResampleDepthLed, "resample_depth_led"}};
+};
+
 template <typename Enum>
 std::string enumToString(Enum v) {
   for (const auto& [value, name] : EnumNames<Enum>::table) {
@@ -124,6 +140,12 @@ std::string toString(InitialGuess v) {
 std::string toString(Reference v) {
   return enumToString(v);
 }
+std::string toString(SyncDepth v) {
+  return enumToString(v);
+}
+std::string toString(UnregisteredColour v) {
+  return enumToString(v);
+}
 void fromString(const std::string& s, Engine& v) {
   enumFromString(s, v);
 }
@@ -137,6 +159,12 @@ void fromString(const std::string& s, InitialGuess& v) {
   enumFromString(s, v);
 }
 void fromString(const std::string& s, Reference& v) {
+  enumFromString(s, v);
+}
+void fromString(const std::string& s, SyncDepth& v) {
+  enumFromString(s, v);
+}
+void fromString(const std::string& s, UnregisteredColour& v) {
   enumFromString(s, v);
 }
 
@@ -165,6 +193,14 @@ std::string validate(const Params& p) {
   check(why, c.depth_noise >= 0.0, "coarse_to_fine.depth_noise", "must not be negative (0 = off)");
   check(why, c.exposure_time >= 0.0 && c.exposure_time <= 1.0, "coarse_to_fine.exposure_time",
         "must be within [0, 1] s (0 = sharp images)");
+  check(why, c.grey_smoothing >= 0.0 && c.grey_smoothing <= 5.0, "coarse_to_fine.grey_smoothing",
+        "must lie in [0, 5] px (0 = none)");
+  check(why, c.edge_variance >= 0.0, "coarse_to_fine.edge_variance",
+        "must not be negative (0 = off)");
+  check(why, c.tukey_sigmas >= 0.0, "coarse_to_fine.tukey_sigmas",
+        "must not be negative (0 = least squares)");
+  check(why, c.exact_depth_grid_stride >= 1 && c.exact_depth_grid_stride <= 100,
+        "coarse_to_fine.exact_depth_grid_stride", "must lie in [1, 100] px");
   check(why, c.level_points > 0, "coarse_to_fine.level_points", "must be positive");
   check(why, c.level_iterations > 0, "coarse_to_fine.level_iterations", "must be positive");
   check(why, c.level_eps > 0.0, "coarse_to_fine.level_eps", "must be positive");
@@ -223,8 +259,8 @@ Params paperParams() {
   // failed or the motion is implausible, never for a low overlap.
   p.odometry.lost_matched_fraction = 0.0;
   p.odometry.hard_matched_fraction = 0.05;
-  p.odometry.sync_depth = false;  // colour and depth paired as they come
-  p.odometry.resample_unregistered_colour = false;  // and the colour used as it comes
+  p.odometry.sync_depth = SyncDepth::kNone;  // colour and depth paired as they come
+  p.odometry.unregistered_colour = UnregisteredColour::kAsGiven;  // the colour as it comes
   p.odometry.second_start = false;                  // one registration per frame
   return p;
 }

@@ -173,8 +173,8 @@ acvo::AcvoConfig toConfig(const acvo::Params& params, LostOdom lost_odom) {
   c.paper_color_ell = params.paper.color_ell;
   c.paper_max_iterations = params.paper.max_iterations;
   c.initial_guess = acvo::toString(params.odometry.initial_guess);
-  c.sync_depth = params.odometry.sync_depth;
-  c.resample_unregistered_colour = params.odometry.resample_unregistered_colour;
+  c.sync_depth = acvo::toString(params.odometry.sync_depth);
+  c.unregistered_colour = acvo::toString(params.odometry.unregistered_colour);
   c.second_start = params.odometry.second_start;
   c.lost_odom = toString(lost_odom);
   return c;
@@ -203,8 +203,8 @@ acvo::Params fromConfig(const acvo::AcvoConfig& config, acvo::Params base) {
   base.paper.color_ell = config.paper_color_ell;
   base.paper.max_iterations = config.paper_max_iterations;
   acvo::fromString(config.initial_guess, base.odometry.initial_guess);
-  base.odometry.sync_depth = config.sync_depth;
-  base.odometry.resample_unregistered_colour = config.resample_unregistered_colour;
+  acvo::fromString(config.sync_depth, base.odometry.sync_depth);
+  acvo::fromString(config.unregistered_colour, base.odometry.unregistered_colour);
   base.odometry.second_start = config.second_start;
   return base;
 }

@@ -622,7 +622,7 @@ TEST(RosParams, ReconfigureRoundTripsAndDescribesEveryParameter) {
   p.coarse_to_fine.point_to_plane = false;
   p.coarse_to_fine.photometric_vignetting = false;
   p.coarse_to_fine.exposure_time = 0.004;
-  p.odometry.sync_depth = false;
+  p.odometry.sync_depth = acvo::SyncDepth::kLastMotion;
   p.odometry.initial_guess = acvo::InitialGuess::kIdentity;
   const acvo::AcvoConfig c = toConfig(p, LostOdom::kNone);
   EXPECT_EQ(c.lost_odom, "none");

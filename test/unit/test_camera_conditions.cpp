@@ -33,7 +33,7 @@ TEST(Sequences, UnsynchronisedColourAndDepthAreBroughtToOneInstant) {
     gt.push_back({text, seq.stamp(i) + o.colour_delay, seq.colourPose(i)});
   }
   Params unsynced;
-  unsynced.odometry.sync_depth = false;
+  unsynced.odometry.sync_depth = SyncDepth::kNone;
   // Measured 0.00036 m/s, 0.0078 deg/s moved and 0.01509, 0.5213 as it came (150 frames of the
   // same motion without the delay: 0.0003, 0.008; moved by the last frame's motion alone 0.00055,
   // 0.0079; by the frame's own alone 0.00041, 0.0083).
@@ -145,7 +145,7 @@ TEST(Sequences, ColourFromASecondCameraIsResampledToTheDepthCamera) {
   o.depth_noise_correlation = 3.0;
   const synth::SynthSequence seq(o);
   Params as_it_came;
-  as_it_came.odometry.resample_unregistered_colour = false;
+  as_it_came.odometry.unregistered_colour = UnregisteredColour::kAsGiven;
   const auto runs = runPolicies<2>(
       {Params(), as_it_came}, seq.size(),
       [&](int i) { return seq.frame(i).toFrame(); }, groundtruthOf(seq));

@@ -253,7 +253,7 @@ TEST(Odometry, DepthOfAnotherInstantIsMovedByTheFramesOwnMotion) {
   const synth::SynthSequence seq = lateColourSequence();
   for (const bool sync : {true, false}) {
     Params params;
-    params.odometry.sync_depth = sync;
+    params.odometry.sync_depth = sync ? SyncDepth::kOwnMotion : SyncDepth::kNone;
     Odometry odo(params);
     odo.reset(seq.colourPose(0));
     for (int i = 0; i < seq.size(); ++i) {
@@ -386,7 +386,7 @@ TEST(Odometry, ResetStartsAgainFromTheGivenPose) {
 // the resampled colour (a grey value at a selected pixel tells which), and every frame after
 // it is resampled by the ratio found. The frames given are not changed. reset() keeps the
 // verdict, which concerns the camera; newCamera() drops it, takeColourCheck() carries it to
-// another Odometry (a parameter change). With resample_unregistered_colour off, the verdict
+// another Odometry (a parameter change). With unregistered_colour as_given, the verdict
 // alone. A registered camera: the verdict, nothing resampled.
 TEST(Odometry, ColourFromASecondCameraIsResampledFromTheVerdictOn) {
   synth::SequenceOptions o;
@@ -433,7 +433,7 @@ TEST(Odometry, ColourFromASecondCameraIsResampledFromTheVerdictOn) {
   EXPECT_FALSE(next.colourCheck().decided());
 
   Params keep;
-  keep.odometry.resample_unregistered_colour = false;
+  keep.odometry.unregistered_colour = UnregisteredColour::kAsGiven;
   Odometry as_it_comes(keep);
   for (int i = 0; i < seq.size(); ++i) {
     EXPECT_FALSE(as_it_comes.process(seq.frame(i).toFrame()).colour_resampled);

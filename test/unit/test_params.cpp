@@ -55,7 +55,7 @@ TEST(Params, ConfigFileHoldsEveryKeyWithTheStructDefaults) {
   const Params loaded = loadParams(path);
   const auto got = flatten(loaded);
   const auto want = flatten(Params());
-  ASSERT_EQ(got.size(), 65u);  // every parameter of visitParams
+  ASSERT_EQ(got.size(), 74u);  // every parameter of visitParams
   EXPECT_EQ(got, want);
   // Equal values could also come from keys missing in the file: check that each key of the
   // sections the default engine reads is written, and that the other engine's is not there.
@@ -115,6 +115,11 @@ TEST(Params, EveryKeyIsReadIntoItsField) {
     } else if constexpr (std::is_same_v<T, Reference>) {
       value = toString(field == Reference::kKeyframe ? Reference::kPreviousFrame
                                                      : Reference::kKeyframe);
+    } else if constexpr (std::is_same_v<T, SyncDepth>) {
+      value = toString(field == SyncDepth::kNone ? SyncDepth::kOwnMotion : SyncDepth::kNone);
+    } else if constexpr (std::is_same_v<T, UnregisteredColour>) {
+      value = toString(field == UnregisteredColour::kAsGiven ? UnregisteredColour::kResample
+                                                             : UnregisteredColour::kAsGiven);
     } else if constexpr (std::is_same_v<T, bool>) {
       value = field ? "false" : "true";
     } else if constexpr (std::is_same_v<T, int>) {

@@ -66,7 +66,7 @@ constexpr int kGridStride = 10;  // pixels between grid points (3072 on a 640x48
 // noise (rendered: at most 0.00006 exact, at least 0.0017 with noise per pixel or in blobs;
 // a Kinect's 0.002): 12288 points. No noise to average, every point is a constraint, as each of
 // ICPOdometry's pixels is (docs/accuracy.md, thirty-fifth round).
-constexpr int kExactGridStride = 5;
+constexpr int kExactGridStride = 5;  // CoarseToFineParams::exact_depth_grid_stride's default
 constexpr double kExactDepthNoise = 0.1;
 constexpr int kGridWindow = 3;   // a window's half size: 7x7 pixels
 constexpr int kNormalReach = 4;  // pixels between a plane's window means
@@ -92,13 +92,17 @@ struct DirectImages {
   DepthGrid grid;
   cv::Mat point_sums;
   bool reference = false;  // addReferenceImages was called
+  double smoothing = 0.0;  // the Gaussian std (px) the grey values were smoothed by
   bool empty() const { return depth.empty(); }
   bool isReference() const { return reference && !depth.empty() && !intensity.empty(); }
 };
 
-// Smoothing of the grey images (pixels, Gaussian std): rendered images sampled without
-// anti-aliasing give intensity steps no sub-pixel shift can match; a Kinect's are smooth already.
+// Smoothing of the grey images (pixels, Gaussian std; CoarseToFineParams::grey_smoothing's
+// default): rendered images sampled without anti-aliasing give intensity steps no sub-pixel
+// shift can match; a Kinect's are smooth already.
 constexpr double kSmoothing = 0.7;
+// Tukey's biweight cut, in standard deviations (CoarseToFineParams::tukey_sigmas' default).
+constexpr double kTukeySigmas = 8.0;
 
 // From the cloud's grey and depth images (empty when the cloud has none): what a moving cloud
 // needs; with `dense` the depth grid too, unless the cloud's depth was taken at another instant
@@ -106,10 +110,12 @@ constexpr double kSmoothing = 0.7;
 // depth_noise) is 0; with `whole_image` the whole smoothed grey image (the reverse photometric
 // term's).
 DirectImages directImages(const LabelledCloud& cloud, bool dense = false, double depth_noise = 0.0,
-                          bool whole_image = false);
+                          bool whole_image = false, double smoothing = kSmoothing,
+                          int exact_grid_stride = kExactGridStride);
 // The depth grid of a depth image (CV_32FC1 metres, 0 or NaN = none), with its weight for the
 // modelled depth_noise; no points when the weight is 0.
-DepthGrid denseGrid(const cv::Mat& depth, const Camera& camera, double depth_noise);
+DepthGrid denseGrid(const cv::Mat& depth, const Camera& camera, double depth_noise,
+                    int exact_grid_stride = kExactGridStride);
 // What a reference needs more: its whole smoothed grey image and, when it has a depth grid, its
 // points' window sums (none when `images` is empty).
 void addReferenceImages(DirectImages& images, const LabelledCloud& cloud);
@@ -173,7 +179,8 @@ constexpr double kEdgePosition2 = 1.0 / 12.0;  // px^2
 DirectSums photometricSums(const DirectImages& reference, const DirectImages& moving_images,
                            const LabelledCloud& moving, const std::vector<Landing>& landed,
                            bool gain = false, bool vignetting = false,
-                           double edge_position2 = kEdgePosition2);
+                           double edge_position2 = kEdgePosition2,
+                           double tukey_sigmas = kTukeySigmas);
 
 // The reverse direction, r_i = I_ref(pixel_i) - B_i I_moving(pi(T^-1 x_i)) over the reference's
 // points x_i that land in the moving image (moving_images.intensity, from directImages'
@@ -186,7 +193,8 @@ DirectSums reversePhotometricSums(const DirectImages& reference,
                                   const DirectImages& moving_images,
                                   const LabelledCloud& moving_cloud, const Eigen::Isometry3d& T,
                                   const Brightness& brightness,
-                                  double edge_position2 = kEdgePosition2);
+                                  double edge_position2 = kEdgePosition2,
+                                  double tukey_sigmas = kTukeySigmas);
 
 // The brightness of the pairs (at most kBrightnessPairs of them, evenly spaced) that neither
 // image saturates (both under kSaturated) and that are not dark (both at least kDark: a ratio
@@ -241,7 +249,8 @@ class PlaneMemo {
   std::vector<Plane> planes_;
 };
 DirectSums pointToPlaneSums(const DirectImages& reference, const std::vector<Landing>& landed,
-                            double depth_noise, PlaneMemo* memo = nullptr);
+                            double depth_noise, PlaneMemo* memo = nullptr,
+                            double tukey_sigmas = kTukeySigmas);
 // The dense term's weight between a reference and a moving cloud: the moving grid's, 0 when
 // either has no grid (the reference's window sums are built only with its own grid).
 double denseWeight(const DirectImages& reference, const DirectImages& moving_images);
@@ -250,6 +259,6 @@ double denseWeight(const DirectImages& reference, const DirectImages& moving_ima
 // pixels to each side, where the reference's surface does not fold there; weighed by
 // denseWeight. Nothing where that is 0.
 DirectSums densePlaneSums(const DirectImages& reference, const DirectImages& moving_images,
-                          const Eigen::Isometry3d& T);
+                          const Eigen::Isometry3d& T, double tukey_sigmas = kTukeySigmas);
 
 }  // namespace acvo

@@ -264,7 +264,7 @@ Odometry::Registration Odometry::registerTo(const Tracked& reference,
   // A kept start from the rest of the points has already chosen between two maxima by the
   // image's agreement, which the kernel value secondStart compares cannot tell apart there.
   if (params_.odometry.second_start &&
-      !(guess_unknown_ && restStart(reference, guess, reg, r))) {
+      !(guess_unknown_ && params_.odometry.rest_start && restStart(reference, guess, reg, r))) {
     secondStart(reference, guess, reg, r, frame.stamp);
   }
   reg.judgement = judgeTracking(reg.solver, frameMotion(reg.solver.transform), params_.odometry);
@@ -334,8 +334,8 @@ void Odometry::actOnColourVerdict() {
   const ColourDepthCheck::Verdict& v = colour_check_.verdict();
   const bool had = colour_ratio_.has_value();
   colour_ratio_.reset();
-  if (v.state == ColourDepthCheck::State::kUnregistered &&
-      params_.odometry.resample_unregistered_colour) {
+  const UnregisteredColour act = params_.odometry.unregistered_colour;
+  if (v.state == ColourDepthCheck::State::kUnregistered && act != UnregisteredColour::kAsGiven) {
     colour_ratio_ = v.best_ratio;
   }
   if (had == colour_ratio_.has_value()) return;
@@ -347,7 +347,7 @@ void Odometry::actOnColourVerdict() {
   // prepared by the other engine serves either (the dense term waits for a keyframe with a depth
   // grid); the verdict's frame is rebuilt as the keyframe by the new one (checkColour).
   Params engine_params = params_;
-  if (colour_ratio_) {
+  if (colour_ratio_ && act == UnregisteredColour::kResampleDepthLed) {
     engine_params.coarse_to_fine.photometric = false;
     engine_params.coarse_to_fine.depth_led = true;
   }
@@ -362,9 +362,12 @@ void Odometry::takeColourCheck(const ColourDepthCheck& check) {
 std::string Odometry::describeColour() const {
   std::string text = colour_check_.describe();
   if (colour_ratio_) {
-    text += ". Meanwhile each frame's colour is resampled by that ratio, and registered "
-            "without the photometric term, led by the depth "
-            "(odometry/resample_unregistered_colour)";
+    text += params_.odometry.unregistered_colour == UnregisteredColour::kResampleDepthLed
+                ? ". Meanwhile each frame's colour is resampled by that ratio, and registered "
+                  "without the photometric term, led by the depth "
+                  "(odometry/unregistered_colour: resample_depth_led)"
+                : ". Meanwhile each frame's colour is resampled by that ratio "
+                  "(odometry/unregistered_colour: resample)";
   }
   return text;
 }
@@ -432,7 +435,7 @@ Frame Odometry::depthAtColourTime(const Frame& frame, OdometryResult& r) const {
   r.depth_delay = delay;
   // The motion over the delay, as the last frame-to-frame motion says (the colour's stamps
   // measure both); unknown until two frames were tracked.
-  if (!params_.odometry.sync_depth || delay == 0.0) return frame;
+  if (params_.odometry.sync_depth == SyncDepth::kNone || delay == 0.0) return frame;
   const std::optional<Eigen::Isometry3d> moved = motionOver(delay);
   if (!moved ||
       largestPixelShift(*moved, frame.camera, params_.selection.min_depth) < kSyncMinShift) {
@@ -445,7 +448,8 @@ Frame Odometry::depthAtColourTime(const Frame& frame, OdometryResult& r) const {
 }
 
 bool Odometry::retimes(const OdometryResult& r) const {
-  return params_.odometry.sync_depth && r.depth_delay != 0.0 && r.interval > 0.0 &&
+  return params_.odometry.sync_depth == SyncDepth::kOwnMotion && r.depth_delay != 0.0 &&
+         r.interval > 0.0 &&
          engine_->staged();
 }
 
@@ -593,14 +597,17 @@ void Odometry::secondStart(const Tracked& reference, const Eigen::Isometry3d& gu
   // A low kernel value against the last frame's says the first start ended in a wrong maximum.
   const bool scored_low =
       last_objective_ && reg.solver.objective < kTurnStartScoreShare * *last_objective_;
-  if (moved_off && turned_off && scored_low && turnStart(reference, guess, reg, r)) return;
+  if (params_.odometry.turn_start && moved_off && turned_off && scored_low &&
+      turnStart(reference, guess, reg, r)) {
+    return;
+  }
   if (!jerk) {
     // The guess's usual miss, where the guess is a constant-velocity prediction: the camera's
     // velocity changes between the last tracked frames (their running second moment; twists,
     // rotation first) over this interval. An identity guess or one given from outside has no
     // such measure. The sigmas grow with the interval, the floors with its square (a frame
     // dropped: the guess misses by the velocity times the interval's excess).
-    if (!guess_predicted_) return;
+    if (!params_.odometry.second_start_check || !guess_predicted_) return;
     const Matrix6d& change = velocity_changes_.moment();
     const double usual_m = std::sqrt(change.block<3, 3>(3, 3).trace()) * r.interval;
     const double usual_deg =
@@ -613,7 +620,8 @@ void Odometry::secondStart(const Tracked& reference, const Eigen::Isometry3d& gu
   }
   SolverResult again = finestFrom(reference, reg, guess, r);
   if (failed(again.status)) return;
-  const bool pulled_lately = second_start_kept_at_ && stamp >= *second_start_kept_at_ &&
+  const bool pulled_lately = params_.odometry.second_start_memory && second_start_kept_at_ &&
+                             stamp >= *second_start_kept_at_ &&
                              stamp - *second_start_kept_at_ <= kSecondStartMemory;
   if (jerk || pulled_lately) {
     // Beyond what the camera's own acceleration does, or soon after something pulled: the

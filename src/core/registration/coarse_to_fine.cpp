@@ -57,23 +57,29 @@ double addDirectTerms(const LevelSums& s, double ell, const LevelDirect& direct,
   const std::vector<Landing> landed =
       landings(*direct.reference, *direct.moving, *direct.moving_cloud, T);
   if (p.photometric) {
-    const DirectSums d =
-        photometricSums(*direct.reference, *direct.moving, *direct.moving_cloud, landed,
-                        p.photometric_gain, p.photometric_vignetting);
+    const DirectSums d = photometricSums(*direct.reference, *direct.moving, *direct.moving_cloud,
+                                         landed, p.photometric_gain, p.photometric_vignetting,
+                                         p.edge_variance, p.tukey_sigmas);
     brightness = d.brightness;
-    const DirectSums r =
-        reversePhotometricSums(*direct.reference, *direct.reference_cloud, *direct.moving,
-                               *direct.moving_cloud, T, d.brightness);
-    H += (1.0 - kReverseShare) * d.H + kReverseShare * r.H;
-    g += (1.0 - kReverseShare) * d.g + kReverseShare * r.g;
+    if (p.reverse_photometric) {
+      const DirectSums r = reversePhotometricSums(*direct.reference, *direct.reference_cloud,
+                                                  *direct.moving, *direct.moving_cloud, T,
+                                                  d.brightness, p.edge_variance, p.tukey_sigmas);
+      H += (1.0 - kReverseShare) * d.H + kReverseShare * r.H;
+      g += (1.0 - kReverseShare) * d.g + kReverseShare * r.g;
+    } else {
+      H += d.H;
+      g += d.g;
+    }
   }
   if (p.point_to_plane) {
-    const DirectSums d = pointToPlaneSums(*direct.reference, landed, planeFadeNoise(p), &planes);
+    const DirectSums d =
+        pointToPlaneSums(*direct.reference, landed, planeFadeNoise(p), &planes, p.tukey_sigmas);
     H += d.H;
     g += d.g;
   }
   if (p.dense_point_to_plane) {
-    const DirectSums d = densePlaneSums(*direct.reference, *direct.moving, T);
+    const DirectSums d = densePlaneSums(*direct.reference, *direct.moving, T, p.tukey_sigmas);
     H += d.H;
     g += d.g;
   }
@@ -152,7 +158,9 @@ std::shared_ptr<CoarseToFineCloud> prepareCoarseToFine(LabelledCloud cloud,
   out->cloud = std::move(cloud);
   if (directTerms(p)) {
     out->images =
-        directImages(out->cloud, p.dense_point_to_plane, planeFadeNoise(p), p.photometric);
+        directImages(out->cloud, p.dense_point_to_plane, planeFadeNoise(p),
+                     p.photometric && p.reverse_photometric, p.grey_smoothing,
+                     p.exact_depth_grid_stride);
   }
   out->ms_prepare = msSince(t0);
   if (as_reference) prepareCoarseToFineReference(*out, p);

@@ -15,14 +15,12 @@
 namespace acvo {
 namespace {
 
-// Tukey's biweight, (1 - (r / (c sd))^2)^2 and none beyond c standard deviations: a residual
-// far outside its term's own scale (a person crossing the view, an occlusion) stops pulling,
-// where Huber's weight beyond 2 standard deviations kept a constant pull per residual. c = 8:
-// 4.685 (Gaussian residuals' 95% efficiency) and 6 cost rendered rooms up to 24% and 8%;
-// docs/accuracy.md, nineteenth round.
-constexpr double kTukey = 8.0;
-double tukeyWeight(double r, double sd) {
-  const double u = r / (kTukey * sd);
+// Tukey's biweight, (1 - (r / (c sd))^2)^2 and none beyond c standard deviations (c =
+// tukey_sigmas; 1 everywhere for c = 0): a residual far outside its term's own scale (a person
+// crossing the view, an occlusion) stops pulling.
+double tukeyWeight(double r, double sd, double tukey_sigmas) {
+  if (!(tukey_sigmas > 0.0)) return 1.0;
+  const double u = r / (tukey_sigmas * sd);
   const double v = 1.0 - u * u;
   return v > 0.0 ? v * v : 0.0;
 }
@@ -164,7 +162,7 @@ struct Residual {
 // deviations, and the whole times weight(s).
 template <typename Weight>
 DirectSums sumsOf(std::vector<Residual>& residuals, double min_scale, double position_var,
-                  Weight&& weight) {
+                  double tukey_sigmas, Weight&& weight) {
   DirectSums s;
   if (residuals.empty()) return s;
   std::vector<std::pair<double, double>> by_size;
@@ -176,7 +174,7 @@ DirectSums sumsOf(std::vector<Residual>& residuals, double min_scale, double pos
   if (!(factor > 0.0)) return s;
   for (const Residual& q : residuals) {
     const double var = s.scale * s.scale + q.say * position_var;
-    const double w = factor / var * tukeyWeight(q.r, std::sqrt(var));
+    const double w = factor / var * tukeyWeight(q.r, std::sqrt(var), tukey_sigmas);
     s.H.noalias() += w * q.J * q.J.transpose();
     s.g.noalias() -= (w * q.r) * q.J;
   }
@@ -190,17 +188,17 @@ DirectSums sumsOf(std::vector<Residual>& residuals, double min_scale, double pos
 namespace {
 
 // The kernel cv::GaussianBlur takes for kSmoothing on floats: 8 sigma + 1 taps, made odd.
-cv::Mat smoothingKernel() {
-  const int taps = int(std::lround(kSmoothing * 8.0 + 1.0)) | 1;
-  return cv::getGaussianKernel(taps, kSmoothing, CV_32F);
+cv::Mat smoothingKernel(double smoothing) {
+  const int taps = int(std::lround(smoothing * 8.0 + 1.0)) | 1;
+  return cv::getGaussianKernel(taps, smoothing, CV_32F);
 }
 
 // The grey image as the terms sample it: in floats, smoothed by kSmoothing. cv::sepFilter2D
 // from the 8-bit image straight to floats gives cv::GaussianBlur's values on the image
 // converted to floats (equal to the last bit on teddy200's and kitchen7s_dev's frames) in
 // about half the time: the conversion was a pass of its own.
-cv::Mat smoothedIntensity(const cv::Mat& gray) {
-  const cv::Mat k = smoothingKernel();
+cv::Mat smoothedIntensity(const cv::Mat& gray, double smoothing) {
+  const cv::Mat k = smoothingKernel(smoothing);
   cv::Mat out;
   cv::sepFilter2D(gray, out, CV_32F, k, k, cv::Point(-1, -1), 0.0, cv::BORDER_REFLECT_101);
   return out;
@@ -209,7 +207,7 @@ cv::Mat smoothedIntensity(const cv::Mat& gray) {
 }  // namespace
 
 DirectImages directImages(const LabelledCloud& cloud, bool dense, double depth_noise,
-                          bool whole_image) {
+                          bool whole_image, double smoothing, int exact_grid_stride) {
   DirectImages out;
   if (cloud.gray.empty() || cloud.depth.empty() || cloud.pixels.size() != cloud.size()) {
     return out;
@@ -221,7 +219,7 @@ DirectImages directImages(const LabelledCloud& cloud, bool dense, double depth_n
   // The smoothing of smoothedIntensity (its kernel and reflected border, rows first), at the
   // points' pixels only: the whole image is smoothed only where the reverse photometric term
   // reads it (whole_image) or the frame becomes a reference.
-  const cv::Mat kernel = smoothingKernel();
+  const cv::Mat kernel = smoothingKernel(smoothing);
   const int taps = kernel.rows, half = taps / 2;
   const float* k = kernel.ptr<float>();
   const cv::Mat& g = cloud.gray;
@@ -250,13 +248,15 @@ DirectImages directImages(const LabelledCloud& cloud, bool dense, double depth_n
     out.point_intensity[j] = sum;
   }
   if (dense && !cloud.depth_of_another_instant) {
-    out.grid = denseGrid(cloud.depth, cloud.camera, depth_noise);
+    out.grid = denseGrid(cloud.depth, cloud.camera, depth_noise, exact_grid_stride);
   }
-  if (whole_image) out.intensity = smoothedIntensity(cloud.gray);
+  out.smoothing = smoothing;
+  if (whole_image) out.intensity = smoothedIntensity(cloud.gray, smoothing);
   return out;
 }
 
-DepthGrid denseGrid(const cv::Mat& depth, const Camera& camera, double depth_noise) {
+DepthGrid denseGrid(const cv::Mat& depth, const Camera& camera, double depth_noise,
+                    int exact_grid_stride) {
   DepthGrid grid;
   const cv::Mat& D = depth;
   constexpr int w = kGridWindow, quarter = w * w;
@@ -308,7 +308,7 @@ DepthGrid denseGrid(const cv::Mat& depth, const Camera& camera, double depth_noi
   if (!(grid.weight > 0.0)) return grid;
   // The twists above read every kGridStride-th pixel whatever the depth; the points are denser
   // where it is exact.
-  grid.stride = grid.shared_noise < kExactDepthNoise * depth_noise ? kExactGridStride : kGridStride;
+  grid.stride = grid.shared_noise < kExactDepthNoise * depth_noise ? exact_grid_stride : kGridStride;
   const int stride = grid.stride;
   // The window means, over the pixels of the centre's surface.
   grid.points.reserve(std::size_t(D.rows / stride + 1) * std::size_t(D.cols / stride + 1));
@@ -342,7 +342,7 @@ DepthGrid denseGrid(const cv::Mat& depth, const Camera& camera, double depth_noi
 
 void addReferenceImages(DirectImages& images, const LabelledCloud& cloud) {
   if (images.empty() || images.reference || cloud.gray.empty()) return;
-  if (images.intensity.empty()) images.intensity = smoothedIntensity(cloud.gray);
+  if (images.intensity.empty()) images.intensity = smoothedIntensity(cloud.gray, images.smoothing);
   images.reference = true;
   if (images.grid.empty()) return;
   const cv::Mat& D = images.depth;
@@ -461,7 +461,8 @@ Brightness brightnessOf(const std::vector<GreyPair>& pairs, bool gain, bool vign
 
 DirectSums photometricSums(const DirectImages& reference, const DirectImages& moving_images,
                            const LabelledCloud& moving, const std::vector<Landing>& landed,
-                           bool gain, bool vignetting, double edge_position2) {
+                           bool gain, bool vignetting, double edge_position2,
+                           double tukey_sigmas) {
   if (!reference.isReference() || moving_images.point_intensity.size() != moving.size()) return {};
   const Camera& cam = reference.camera;
   const bool pixels = moving.pixels.size() == moving.size();
@@ -494,8 +495,8 @@ DirectSums photometricSums(const DirectImages& reference, const DirectImages& mo
   for (std::size_t k = 0; k < landed.size(); ++k) {
     residuals[k].r = double(grey[k].reference) - b.at(grey[k].shift) * double(grey[k].moving);
   }
-  DirectSums s =
-      sumsOf(residuals, kMinIntensityScale, edge_position2, [](double) { return 1.0; });
+  DirectSums s = sumsOf(residuals, kMinIntensityScale, edge_position2, tukey_sigmas,
+                        [](double) { return 1.0; });
   s.brightness = b;
   return s;
 }
@@ -504,7 +505,8 @@ DirectSums reversePhotometricSums(const DirectImages& reference,
                                   const LabelledCloud& reference_cloud,
                                   const DirectImages& moving_images,
                                   const LabelledCloud& moving_cloud, const Eigen::Isometry3d& T,
-                                  const Brightness& brightness, double edge_position2) {
+                                  const Brightness& brightness, double edge_position2,
+                                  double tukey_sigmas) {
   const cv::Mat& I = moving_images.intensity;
   const std::size_t n = reference_cloud.size();
   if (I.empty() || moving_images.empty() || reference.point_intensity.size() != n ||
@@ -551,11 +553,12 @@ DirectSums reversePhotometricSums(const DirectImages& reference,
     q.J << -b * e.cross(x), b * e;
     residuals.push_back(q);
   }
-  return sumsOf(residuals, kMinIntensityScale, edge_position2, [](double) { return 1.0; });
+  return sumsOf(residuals, kMinIntensityScale, edge_position2, tukey_sigmas,
+                [](double) { return 1.0; });
 }
 
 DirectSums pointToPlaneSums(const DirectImages& reference, const std::vector<Landing>& landed,
-                            double depth_noise, PlaneMemo* memo) {
+                            double depth_noise, PlaneMemo* memo, double tukey_sigmas) {
   if (reference.empty()) return {};
   const Camera& cam = reference.camera;
   const cv::Mat& D = reference.depth;
@@ -596,7 +599,7 @@ DirectSums pointToPlaneSums(const DirectImages& reference, const std::vector<Lan
   }
   // Both points' depth noise, as the kernel assumes it.
   const double modelled = std::sqrt(2.0) * depth_noise;
-  return sumsOf(residuals, kMinPlaneScale, 0.0,
+  return sumsOf(residuals, kMinPlaneScale, 0.0, tukey_sigmas,
                 [modelled](double scale) { return planeFade(scale, modelled); });
 }
 
@@ -619,7 +622,7 @@ double denseWeight(const DirectImages& reference, const DirectImages& moving_ima
 }
 
 DirectSums densePlaneSums(const DirectImages& reference, const DirectImages& moving_images,
-                          const Eigen::Isometry3d& T) {
+                          const Eigen::Isometry3d& T, double tukey_sigmas) {
   const double weight = denseWeight(reference, moving_images);
   if (!(weight > 0.0)) return {};
   const DepthGrid& grid = moving_images.grid;
@@ -679,7 +682,7 @@ DirectSums densePlaneSums(const DirectImages& reference, const DirectImages& mov
     q.J << inv_z2 * y.cross(n), inv_z2 * n;
     residuals.push_back(q);
   }
-  return sumsOf(residuals, kMinPlaneScale, 0.0, [weight](double) { return weight; });
+  return sumsOf(residuals, kMinPlaneScale, 0.0, tukey_sigmas, [weight](double) { return weight; });
 }
 
 }  // namespace acvo
