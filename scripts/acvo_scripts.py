@@ -46,6 +46,7 @@ BENCH_OUT = os.path.join(ROOT, "build", "bench")  # scripts/bench's outputs and 
 SHARED_DATA = os.path.join(ROOT, "..", "shared", "data")
 TEDDY = os.path.join(SHARED_DATA, "tum_fr3_teddy200")
 KITCHEN = os.path.join(SHARED_DATA, "kitchen7s_dev")
+KITCHEN2 = os.path.join(SHARED_DATA, "kitchen7s_dev2")
 MANAGER = "/acvo_manager"  # acvo.launch's manager for name:=acvo
 ANSI = re.compile(r"\x1b\[[0-9;]*m")  # roscpp's colour codes in the launch log
 
@@ -184,7 +185,7 @@ def synthetic_dataset(structure, texture, frames, who="bench"):
                            frames, options, who)
 
 
-def real_datasets(candidates=(TEDDY, KITCHEN)):
+def real_datasets(candidates=(TEDDY, KITCHEN, KITCHEN2)):
     """Those of the shared real data sets that are present, as real paths."""
     return [os.path.realpath(d) for d in candidates if os.path.isdir(d)]
 
