@@ -29,10 +29,10 @@
 #include <tbb/task_arena.h>
 #include <opencv2/imgproc.hpp>
 
-#include "acvo/depth.hpp"
-#include "acvo/labelled_cloud.hpp"
-#include "acvo/order_statistics.hpp"
-#include "acvo/point_selector.hpp"
+#include "acvo/cloud/depth.hpp"
+#include "acvo/cloud/labelled_cloud.hpp"
+#include "acvo/math/order_statistics.hpp"
+#include "acvo/cloud/point_selector.hpp"
 #include "frame_pair.hpp"
 
 namespace {

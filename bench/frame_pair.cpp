@@ -4,8 +4,8 @@
 #include <filesystem>
 #include <stdexcept>
 
-#include "acvo/labelled_cloud.hpp"
-#include "acvo/tum.hpp"
+#include "acvo/cloud/labelled_cloud.hpp"
+#include "acvo/dataset/tum.hpp"
 #include "synth/sequence.hpp"
 
 namespace acvo::bench {

@@ -8,7 +8,7 @@
 
 #include <memory>
 
-#include "acvo/frame.hpp"
+#include "acvo/cloud/frame.hpp"
 #include "acvo/params.hpp"
 #include "acvo/registration/coarse_to_fine.hpp"
 #include "acvo/registration/paper.hpp"

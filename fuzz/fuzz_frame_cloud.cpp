@@ -26,14 +26,14 @@
 #include <tbb/global_control.h>
 #include <opencv2/imgproc.hpp>
 
-#include "acvo/colour_depth_check.hpp"
-#include "acvo/depth.hpp"
-#include "acvo/frame.hpp"
+#include "acvo/cloud/colour_depth_check.hpp"
+#include "acvo/cloud/depth.hpp"
+#include "acvo/cloud/frame.hpp"
 #include "acvo/registration/coarse_to_fine.hpp"
 #include "acvo/registration/paper.hpp"
-#include "acvo/labelled_cloud.hpp"
-#include "acvo/odometry.hpp"
-#include "acvo/se3.hpp"
+#include "acvo/cloud/labelled_cloud.hpp"
+#include "acvo/odometry/odometry.hpp"
+#include "acvo/math/se3.hpp"
 #include "fuzz_input.hpp"
 
 #define FUZZ_CHECK(cond)                                                                  \

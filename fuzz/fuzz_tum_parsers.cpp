@@ -13,9 +13,9 @@
 #include <string>
 #include <vector>
 
-#include "acvo/camera.hpp"
+#include "acvo/cloud/camera.hpp"
 #include "acvo/params.hpp"
-#include "acvo/tum.hpp"
+#include "acvo/dataset/tum.hpp"
 
 #define FUZZ_CHECK(cond)                                                                  \
   do {                                                                                    \

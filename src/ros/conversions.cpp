@@ -12,7 +12,7 @@
 #include <tf2_eigen/tf2_eigen.h>
 #include <opencv2/imgproc.hpp>
 
-#include "acvo/depth.hpp"
+#include "acvo/cloud/depth.hpp"
 #include "point_types.hpp"
 
 namespace acvo_ros {

@@ -16,9 +16,9 @@
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
-#include "acvo/camera.hpp"
-#include "acvo/frame.hpp"
-#include "acvo/labelled_cloud.hpp"
+#include "acvo/cloud/camera.hpp"
+#include "acvo/cloud/frame.hpp"
+#include "acvo/cloud/labelled_cloud.hpp"
 
 namespace acvo_ros {
 

@@ -7,7 +7,7 @@
 
 #include <Eigen/Core>
 
-#include "acvo/covariance.hpp"
+#include "acvo/odometry/covariance.hpp"
 
 namespace acvo_ros {
 

@@ -11,7 +11,7 @@
 #include <Eigen/Geometry>
 
 #include "acvo/OdometryInfo.h"
-#include "acvo/odometry.hpp"
+#include "acvo/odometry/odometry.hpp"
 #include "covariance.hpp"
 
 namespace acvo_ros {

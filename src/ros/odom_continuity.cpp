@@ -1,7 +1,7 @@
 #include "odom_continuity.hpp"
 
-#include "acvo/covariance.hpp"
-#include "acvo/se3.hpp"
+#include "acvo/odometry/covariance.hpp"
+#include "acvo/math/se3.hpp"
 
 namespace acvo_ros {
 

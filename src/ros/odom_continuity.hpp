@@ -18,7 +18,7 @@
 
 #include <Eigen/Geometry>
 
-#include "acvo/odometry.hpp"
+#include "acvo/odometry/odometry.hpp"
 
 namespace acvo_ros {
 

@@ -39,8 +39,9 @@
 
 #include "acvo/AcvoConfig.h"
 #include "acvo/ResetToPose.h"
-#include "acvo/colour_depth_check.hpp"
-#include "acvo/odometry.hpp"
+#include "acvo/cloud/colour_depth_check.hpp"
+#include "acvo/odometry/odometry.hpp"
+#include "acvo/timing.hpp"
 #include "cause_throttle.hpp"
 #include "conversions.hpp"
 #include "covariance.hpp"
@@ -68,10 +69,6 @@ constexpr double kGuessWarning = 10.0;
 // Period of the note on the camera intrinsics in use, when they change (s).
 constexpr double kCameraNote = 5.0;
 
-double msSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-      .count();
-}
 }  // namespace
 
 class OdometryNodelet : public nodelet::Nodelet {
@@ -313,7 +310,7 @@ void OdometryNodelet::subscribe() {
 
 void OdometryNodelet::onFrame(const ImageConstPtr& rgb, const ImageConstPtr& depth,
                               const CameraInfoConstPtr& info) {
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = acvo::Clock::now();
   std::lock_guard<std::mutex> lock(mutex_);
   try {
     processFrame(*rgb, *depth, *info);
@@ -324,7 +321,7 @@ void OdometryNodelet::onFrame(const ImageConstPtr& rgb, const ImageConstPtr& dep
     header.frame_id = stripSlash(rgb->header.frame_id);
     try {
       reject(header, std::string("unexpected error while processing the frame: ") + e.what(),
-             msSince(start));
+             acvo::msSince(start));
     } catch (const std::exception& again) {
       NODELET_ERROR_THROTTLE(5.0, "frame at %.6f skipped: %s (and reporting it failed: %s)",
                              rgb->header.stamp.toSec(), e.what(), again.what());
@@ -333,7 +330,7 @@ void OdometryNodelet::onFrame(const ImageConstPtr& rgb, const ImageConstPtr& dep
 }
 
 void OdometryNodelet::processFrame(const Image& rgb, const Image& depth, const Info& info) {
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = acvo::Clock::now();
   last_.wall = ros::WallTime::now();
   last_.synchronised = true;
   if (paused_) {
@@ -347,7 +344,7 @@ void OdometryNodelet::processFrame(const Image& rgb, const Image& depth, const I
   std::variant<acvo::Frame, Rejection> converted =
       frameFromMessages(rgb, depth, info, settings_.intrinsics, topics_);
   if (const Rejection* rejection = std::get_if<Rejection>(&converted)) {
-    reject(header, rejection->why, msSince(start));
+    reject(header, rejection->why, acvo::msSince(start));
     return;
   }
   const acvo::Frame& frame = std::get<acvo::Frame>(converted);
@@ -404,7 +401,7 @@ void OdometryNodelet::processFrame(const Image& rgb, const Image& depth, const I
   extras.guess_from_tf = tf.motion_guess.has_value() && r.tracking != acvo::Tracking::kFirstFrame;
   if (r.tracking == acvo::Tracking::kBadFrame) {
     // The conversion checks what the odometry checks: this is a safety net.
-    reject(header, r.message, msSince(start));
+    reject(header, r.message, acvo::msSince(start));
     return;
   }
   stamps_.processed(header.stamp.toSec());
@@ -423,7 +420,7 @@ void OdometryNodelet::processFrame(const Image& rgb, const Image& depth, const I
   publish(r, pose, header, tf);
   // On the ROS clock, as the stamps are: sim time when a bag is played with --clock.
   extras.ms_latency = (ros::Time::now() - header.stamp).toSec() * 1000.0;
-  extras.ms_total = msSince(start);
+  extras.ms_total = acvo::msSince(start);
   extras.lost_count = count_.lost;
   publishInfo(r, header, extras);
 }

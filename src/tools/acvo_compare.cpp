@@ -26,10 +26,10 @@
 #include <string>
 #include <vector>
 
-#include "acvo/evaluation.hpp"
-#include "acvo/odometry.hpp"
+#include "acvo/dataset/evaluation.hpp"
+#include "acvo/odometry/odometry.hpp"
 #include "acvo/params.hpp"
-#include "acvo/tum.hpp"
+#include "acvo/dataset/tum.hpp"
 #include "peers.hpp"
 #include "tool_support.hpp"
 

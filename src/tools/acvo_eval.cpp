@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
-#include "acvo/evaluation.hpp"
-#include "acvo/tum.hpp"
+#include "acvo/dataset/evaluation.hpp"
+#include "acvo/dataset/tum.hpp"
 #include "tool_support.hpp"
 
 namespace {

@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "acvo/odometry.hpp"
+#include "acvo/odometry/odometry.hpp"
 #include "synth/sequence.hpp"
 #include "tool_support.hpp"
 

@@ -13,10 +13,10 @@
 #include <string>
 #include <vector>
 
-#include "acvo/colour_depth_check.hpp"
-#include "acvo/odometry.hpp"
+#include "acvo/cloud/colour_depth_check.hpp"
+#include "acvo/odometry/odometry.hpp"
 #include "acvo/params.hpp"
-#include "acvo/tum.hpp"
+#include "acvo/dataset/tum.hpp"
 #include "tool_support.hpp"
 
 namespace {

@@ -12,8 +12,8 @@
 
 #include <Eigen/Geometry>
 
-#include "acvo/camera.hpp"
-#include "acvo/frame.hpp"
+#include "acvo/cloud/camera.hpp"
+#include "acvo/cloud/frame.hpp"
 
 namespace acvo::peers {
 

@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "acvo/params.hpp"
-#include "acvo/tum.hpp"
+#include "acvo/dataset/tum.hpp"
 
 namespace acvo::tools {
 

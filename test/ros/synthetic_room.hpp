@@ -6,7 +6,7 @@
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
-#include "acvo/camera.hpp"
+#include "acvo/cloud/camera.hpp"
 
 namespace acvo_test {
 

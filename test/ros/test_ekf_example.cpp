@@ -15,7 +15,7 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
-#include "acvo/odometry.hpp"
+#include "acvo/odometry/odometry.hpp"
 #include "covariance.hpp"
 #include "messages.hpp"
 #include "nodelet_settings.hpp"

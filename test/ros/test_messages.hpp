@@ -11,7 +11,7 @@
 #include <sensor_msgs/image_encodings.h>
 #include <opencv2/imgproc.hpp>
 
-#include "acvo/camera.hpp"
+#include "acvo/cloud/camera.hpp"
 
 namespace acvo_test {
 

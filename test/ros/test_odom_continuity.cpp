@@ -2,7 +2,7 @@
 // the odometry written out by hand: what it does with each kind of frame, without images.
 #include <gtest/gtest.h>
 
-#include "acvo/se3.hpp"
+#include "acvo/math/se3.hpp"
 #include "odom_continuity.hpp"
 
 namespace acvo_ros {

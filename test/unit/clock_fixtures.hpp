@@ -8,7 +8,7 @@
 
 #include <Eigen/Geometry>
 
-#include "acvo/tum.hpp"
+#include "acvo/dataset/tum.hpp"
 
 namespace acvo::test {
 

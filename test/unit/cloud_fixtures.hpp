@@ -5,7 +5,7 @@
 #include <cmath>
 #include <random>
 
-#include "acvo/labelled_cloud.hpp"
+#include "acvo/cloud/labelled_cloud.hpp"
 #include "acvo/params.hpp"
 
 namespace acvo::test {

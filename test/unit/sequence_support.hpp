@@ -11,8 +11,8 @@
 
 #include <gtest/gtest.h>
 
-#include "acvo/evaluation.hpp"
-#include "acvo/odometry.hpp"
+#include "acvo/dataset/evaluation.hpp"
+#include "acvo/odometry/odometry.hpp"
 #include "synth/sequence.hpp"
 
 namespace acvo::test {

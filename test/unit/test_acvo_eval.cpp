@@ -10,7 +10,7 @@
 
 #include <gtest/gtest.h>
 
-#include "acvo/tum.hpp"
+#include "acvo/dataset/tum.hpp"
 #include "clock_fixtures.hpp"
 #include "test_support.hpp"
 

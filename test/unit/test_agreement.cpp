@@ -4,9 +4,9 @@
 
 #include <gtest/gtest.h>
 
-#include "acvo/agreement.hpp"
-#include "acvo/labelled_cloud.hpp"
-#include "acvo/odometry.hpp"
+#include "acvo/odometry/agreement.hpp"
+#include "acvo/cloud/labelled_cloud.hpp"
+#include "acvo/odometry/odometry.hpp"
 #include "synth/sequence.hpp"
 
 namespace acvo {

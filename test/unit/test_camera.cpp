@@ -7,7 +7,7 @@
 
 #include <gtest/gtest.h>
 
-#include "acvo/camera.hpp"
+#include "acvo/cloud/camera.hpp"
 #include "test_support.hpp"
 
 namespace {

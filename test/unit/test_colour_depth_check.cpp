@@ -10,9 +10,9 @@
 #include <set>
 #include <utility>
 
-#include "acvo/colour_depth_check.hpp"
-#include "acvo/odometry.hpp"
-#include "acvo/tum.hpp"
+#include "acvo/cloud/colour_depth_check.hpp"
+#include "acvo/odometry/odometry.hpp"
+#include "acvo/dataset/tum.hpp"
 #include "synth/sequence.hpp"
 #include "test_support.hpp"
 

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "acvo/camera.hpp"
+#include "acvo/cloud/camera.hpp"
 #include "test_support.hpp"
 
 namespace acvo {

@@ -9,8 +9,8 @@
 
 #include <gtest/gtest.h>
 
-#include "acvo/odometry.hpp"
-#include "acvo/se3.hpp"
+#include "acvo/odometry/odometry.hpp"
+#include "acvo/math/se3.hpp"
 #include "synth/sequence.hpp"
 
 namespace acvo {

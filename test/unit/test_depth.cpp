@@ -10,9 +10,9 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/rgbd/depth.hpp>
 
-#include "acvo/depth.hpp"
-#include "acvo/se3.hpp"
-#include "acvo/tum.hpp"
+#include "acvo/cloud/depth.hpp"
+#include "acvo/math/se3.hpp"
+#include "acvo/dataset/tum.hpp"
 #include "test_support.hpp"
 
 namespace {

@@ -15,11 +15,11 @@
 
 #include <gtest/gtest.h>
 
-#include "acvo/labelled_cloud.hpp"
+#include "acvo/cloud/labelled_cloud.hpp"
 #include "acvo/params.hpp"
 #include "acvo/registration/coarse_to_fine.hpp"
 #include "acvo/registration/direct_terms.hpp"
-#include "acvo/se3.hpp"
+#include "acvo/math/se3.hpp"
 #include "synth/layout.hpp"
 #include "synth/renderer.hpp"
 #include "synth/scene.hpp"

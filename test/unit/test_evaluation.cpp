@@ -9,8 +9,8 @@
 
 #include <gtest/gtest.h>
 
-#include "acvo/evaluation.hpp"
-#include "acvo/tum.hpp"
+#include "acvo/dataset/evaluation.hpp"
+#include "acvo/dataset/tum.hpp"
 #include "clock_fixtures.hpp"
 #include "test_support.hpp"
 

@@ -13,10 +13,10 @@
 #include <gtest/gtest.h>
 #include <opencv2/core.hpp>
 
-#include "acvo/labelled_cloud.hpp"
-#include "acvo/odometry.hpp"
+#include "acvo/cloud/labelled_cloud.hpp"
+#include "acvo/odometry/odometry.hpp"
 #include "acvo/registration/kernel.hpp"
-#include "acvo/tum.hpp"
+#include "acvo/dataset/tum.hpp"
 #include "test_support.hpp"
 
 namespace {

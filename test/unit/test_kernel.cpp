@@ -5,7 +5,7 @@
 #include "acvo/registration/kernel.hpp"
 #include "acvo/registration/paper.hpp"
 #include "acvo/registration/paper_kernel.hpp"
-#include "acvo/se3.hpp"
+#include "acvo/math/se3.hpp"
 #include "cloud_fixtures.hpp"
 
 namespace acvo {

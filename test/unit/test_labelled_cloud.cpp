@@ -14,9 +14,9 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "acvo/depth.hpp"
-#include "acvo/hsv.hpp"
-#include "acvo/labelled_cloud.hpp"
+#include "acvo/cloud/depth.hpp"
+#include "acvo/cloud/hsv.hpp"
+#include "acvo/cloud/labelled_cloud.hpp"
 #include "test_support.hpp"
 
 namespace acvo {

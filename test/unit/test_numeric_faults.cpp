@@ -10,8 +10,8 @@
 
 #include <gtest/gtest.h>
 
-#include "acvo/odometry.hpp"
-#include "acvo/registration.hpp"
+#include "acvo/odometry/odometry.hpp"
+#include "acvo/registration/engine.hpp"
 #include "cloud_fixtures.hpp"
 #include "synth/sequence.hpp"
 

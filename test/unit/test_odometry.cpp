@@ -10,9 +10,9 @@
 #include <Eigen/Eigenvalues>
 #include <opencv2/core.hpp>
 
-#include "acvo/depth.hpp"
-#include "acvo/odometry.hpp"
-#include "acvo/se3.hpp"
+#include "acvo/cloud/depth.hpp"
+#include "acvo/odometry/odometry.hpp"
+#include "acvo/math/se3.hpp"
 #include "synth/sequence.hpp"
 
 namespace acvo {

@@ -9,7 +9,7 @@
 
 #include <gtest/gtest.h>
 
-#include "acvo/order_statistics.hpp"
+#include "acvo/math/order_statistics.hpp"
 
 namespace acvo {
 namespace {

@@ -11,7 +11,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
-#include "acvo/evaluation.hpp"
+#include "acvo/dataset/evaluation.hpp"
 #include "peers.hpp"
 #include "synth/sequence.hpp"
 

@@ -16,8 +16,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include "../../src/core/cloud/selection_maps.hpp"
-#include "acvo/depth.hpp"
-#include "acvo/point_selector.hpp"
+#include "acvo/cloud/depth.hpp"
+#include "acvo/cloud/point_selector.hpp"
 #include "test_support.hpp"
 
 namespace acvo {

@@ -9,7 +9,7 @@
 
 #include <gtest/gtest.h>
 
-#include "acvo/tum.hpp"
+#include "acvo/dataset/tum.hpp"
 #include "sequence_support.hpp"
 #include "test_support.hpp"
 

@@ -5,10 +5,10 @@
 
 #include <gtest/gtest.h>
 
-#include "acvo/labelled_cloud.hpp"
-#include "acvo/registration.hpp"
+#include "acvo/cloud/labelled_cloud.hpp"
+#include "acvo/registration/engine.hpp"
 #include "acvo/registration/paper.hpp"
-#include "acvo/se3.hpp"
+#include "acvo/math/se3.hpp"
 #include "synth/layout.hpp"
 #include "synth/renderer.hpp"
 #include "synth/scene.hpp"

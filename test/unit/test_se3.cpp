@@ -3,7 +3,7 @@
 
 #include <gtest/gtest.h>
 
-#include "acvo/se3.hpp"
+#include "acvo/math/se3.hpp"
 
 namespace acvo {
 namespace {

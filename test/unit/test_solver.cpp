@@ -6,7 +6,7 @@
 
 #include "acvo/registration/coarse_to_fine.hpp"
 #include "acvo/registration/paper.hpp"
-#include "acvo/se3.hpp"
+#include "acvo/math/se3.hpp"
 #include "cloud_fixtures.hpp"
 
 namespace acvo {

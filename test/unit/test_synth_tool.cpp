@@ -16,8 +16,8 @@
 
 #include <opencv2/imgcodecs.hpp>
 
-#include "acvo/camera.hpp"
-#include "acvo/tum.hpp"
+#include "acvo/cloud/camera.hpp"
+#include "acvo/dataset/tum.hpp"
 #include "synth/layout.hpp"
 #include "synth/sequence.hpp"
 #include "test_support.hpp"

@@ -14,7 +14,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "acvo/tum.hpp"
+#include "acvo/dataset/tum.hpp"
 #include "test_support.hpp"
 
 namespace {

@@ -3,7 +3,7 @@
 
 #include <gtest/gtest.h>
 
-#include "acvo/velocity_changes.hpp"
+#include "acvo/odometry/velocity_changes.hpp"
 
 namespace acvo {
 namespace {

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "acvo/params.hpp"
-#include "acvo/registration.hpp"
+#include "acvo/registration/engine.hpp"
 #include "acvo/registration/direct_terms.hpp"
 #include "acvo/registration/kernel.hpp"
 

@@ -30,9 +30,9 @@
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
-#include "acvo/camera.hpp"
-#include "acvo/labelled_cloud.hpp"
-#include "acvo/se3.hpp"
+#include "acvo/cloud/camera.hpp"
+#include "acvo/cloud/labelled_cloud.hpp"
+#include "acvo/math/se3.hpp"
 
 namespace acvo {
 

@@ -16,7 +16,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include "acvo/labelled_cloud.hpp"
+#include "acvo/cloud/labelled_cloud.hpp"
 
 namespace acvo {
 

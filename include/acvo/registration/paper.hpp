@@ -11,7 +11,7 @@
 #include <Eigen/Geometry>
 
 #include "acvo/params.hpp"
-#include "acvo/registration.hpp"
+#include "acvo/registration/engine.hpp"
 #include "acvo/registration/paper_kernel.hpp"
 
 namespace acvo {

@@ -13,9 +13,9 @@
 #include <Eigen/Geometry>
 
 #include "acvo/params.hpp"
-#include "acvo/registration.hpp"
+#include "acvo/registration/engine.hpp"
 #include "acvo/registration/kernel.hpp"
-#include "acvo/se3.hpp"
+#include "acvo/math/se3.hpp"
 
 namespace acvo {
 

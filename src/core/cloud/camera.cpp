@@ -1,6 +1,6 @@
 // Pinhole intrinsics and lens: validity, the TUM cameras by name (fr1, fr2, fr3), camera.yaml
 // read/write.
-#include "acvo/camera.hpp"
+#include "acvo/cloud/camera.hpp"
 
 #include <algorithm>
 #include <array>

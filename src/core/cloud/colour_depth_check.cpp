@@ -1,5 +1,5 @@
 // Is the depth registered to the colour? (acvo/colour_depth_check.hpp)
-#include "acvo/colour_depth_check.hpp"
+#include "acvo/cloud/colour_depth_check.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,5 +1,5 @@
 // Depth decoding into metres (TUM PNG, 16UC1 millimetres, 32FC1 metres); invalid depth as 0.
-#include "acvo/depth.hpp"
+#include "acvo/cloud/depth.hpp"
 
 #include <cmath>
 #include <limits>

@@ -1,5 +1,5 @@
 // What makes a frame unusable (Frame::problem): sizes, types, intrinsics, stamp; its grey image.
-#include "acvo/frame.hpp"
+#include "acvo/cloud/frame.hpp"
 
 #include <cmath>
 #include <sstream>

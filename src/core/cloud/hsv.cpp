@@ -1,5 +1,5 @@
 // OpenCV's 8-bit HSV for single pixels: a cloud converts only its selected pixels.
-#include "acvo/hsv.hpp"
+#include "acvo/cloud/hsv.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,6 +1,6 @@
 // A frame's labelled cloud (docs/method.md §1): selected pixels back-projected, with their
 // HSV and gradient labels and colours.
-#include "acvo/labelled_cloud.hpp"
+#include "acvo/cloud/labelled_cloud.hpp"
 
 #include <chrono>
 #include <cmath>
@@ -8,16 +8,11 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "acvo/hsv.hpp"
+#include "acvo/cloud/hsv.hpp"
+#include "acvo/timing.hpp"
 
 namespace acvo {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double msSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 // R, G, B of one pixel whatever the frame's channel order (grey replicated).
 std::array<std::uint8_t, 3> rgbAt(const Frame& frame, int u, int v) {

@@ -9,7 +9,7 @@
 //   lands on the edge itself rather than on the coarse pixel's corner.
 // - The target count applies before the depth check (as in the reference code): on Kinect
 //   frames about 14 % of the selected pixels have no valid depth and are dropped afterwards.
-#include "acvo/point_selector.hpp"
+#include "acvo/cloud/point_selector.hpp"
 
 #include <algorithm>
 #include <cmath>

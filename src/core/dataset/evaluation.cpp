@@ -1,5 +1,5 @@
 // RPE and ATE as the TUM RGB-D benchmark tools compute them (docs/method.md §8).
-#include "acvo/evaluation.hpp"
+#include "acvo/dataset/evaluation.hpp"
 
 #include <algorithm>
 #include <cmath>

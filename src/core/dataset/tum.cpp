@@ -1,5 +1,5 @@
 // TUM RGB-D folders: image lists, rgb/depth association, ground truth, trajectories.
-#include "acvo/tum.hpp"
+#include "acvo/dataset/tum.hpp"
 
 #include <algorithm>
 #include <charconv>
@@ -15,7 +15,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "acvo/depth.hpp"
+#include "acvo/cloud/depth.hpp"
 #include "stamp_association.hpp"
 
 namespace acvo {

@@ -1,4 +1,4 @@
-#include "acvo/agreement.hpp"
+#include "acvo/odometry/agreement.hpp"
 
 #include <cmath>
 #include <cstdint>

@@ -1,5 +1,5 @@
 // Covariances of motions and poses (docs/method.md §7).
-#include "acvo/covariance.hpp"
+#include "acvo/odometry/covariance.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,6 +1,6 @@
 // The odometry pipeline (docs/method.md §7): each frame's cloud, its registration to the
 // keyframe, the pose and its covariance, the tracking judgement and the keyframe choice.
-#include "acvo/odometry.hpp"
+#include "acvo/odometry/odometry.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -9,9 +9,10 @@
 
 #include <tbb/task_arena.h>
 
-#include "acvo/agreement.hpp"
-#include "acvo/covariance.hpp"
-#include "acvo/depth.hpp"
+#include "acvo/odometry/agreement.hpp"
+#include "acvo/odometry/covariance.hpp"
+#include "acvo/cloud/depth.hpp"
+#include "acvo/timing.hpp"
 
 namespace acvo {
 
@@ -97,10 +98,6 @@ double rotationDeg(const Eigen::Isometry3d& T) {
   return logSE3(T).head<3>().norm() * 180.0 / M_PI;
 }
 
-using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 // A second start's cost added to the first's: the frame's cost is both starts', whichever is kept
 // (Odometry::keepSecondStart).

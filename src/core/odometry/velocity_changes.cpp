@@ -1,4 +1,4 @@
-#include "acvo/velocity_changes.hpp"
+#include "acvo/odometry/velocity_changes.hpp"
 
 #include <algorithm>
 

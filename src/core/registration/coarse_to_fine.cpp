@@ -10,15 +10,11 @@
 
 #include <Eigen/Cholesky>
 
-#include "acvo/covariance.hpp"
+#include "acvo/odometry/covariance.hpp"
+#include "acvo/timing.hpp"
 
 namespace acvo {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 // Steps this well aligned (cosine) are taken as one linear convergence (extrapolatedStep).
 constexpr double kAlignedSteps = 0.9;

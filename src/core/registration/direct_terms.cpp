@@ -10,7 +10,7 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "acvo/order_statistics.hpp"
+#include "acvo/math/order_statistics.hpp"
 
 namespace acvo {
 namespace {

@@ -6,15 +6,11 @@
 #include <chrono>
 #include <cmath>
 
-#include "acvo/covariance.hpp"
+#include "acvo/odometry/covariance.hpp"
+#include "acvo/timing.hpp"
 
 namespace acvo {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 double firstEll(const PaperParams& p) {
   return p.ell_policy == EllPolicy::kAdaptive ? p.ell_init : scheduledEll(0);

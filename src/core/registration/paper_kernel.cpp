@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "acvo/se3.hpp"
+#include "acvo/math/se3.hpp"
 
 namespace acvo {
 

@@ -1,4 +1,4 @@
-#include "acvo/order_statistics.hpp"
+#include "acvo/math/order_statistics.hpp"
 
 #include <algorithm>
 #include <array>

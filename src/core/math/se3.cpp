@@ -1,5 +1,5 @@
 // SE(3) exponential and logarithm in closed form, with small-angle series.
-#include "acvo/se3.hpp"
+#include "acvo/math/se3.hpp"
 
 #include <cmath>
 

@@ -34,7 +34,7 @@
 #include <string>
 #include <vector>
 
-#include "acvo/frame.hpp"
+#include "acvo/cloud/frame.hpp"
 
 namespace acvo {
 

@@ -4,7 +4,7 @@
 // check (odometry.hpp) asks whether a registration missed its guess unusually for this camera.
 #pragma once
 
-#include "acvo/se3.hpp"
+#include "acvo/math/se3.hpp"
 
 namespace acvo {
 

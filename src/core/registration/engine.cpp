@@ -1,5 +1,5 @@
 // The engines behind one interface: picking one by name, and what their results share.
-#include "acvo/registration.hpp"
+#include "acvo/registration/engine.hpp"
 
 #include <stdexcept>
 

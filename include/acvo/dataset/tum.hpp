@@ -8,8 +8,8 @@
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
-#include "acvo/camera.hpp"
-#include "acvo/frame.hpp"
+#include "acvo/cloud/camera.hpp"
+#include "acvo/cloud/frame.hpp"
 
 namespace acvo {
 

@@ -10,9 +10,9 @@
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
-#include "acvo/frame.hpp"
+#include "acvo/cloud/frame.hpp"
 #include "acvo/params.hpp"
-#include "acvo/point_selector.hpp"
+#include "acvo/cloud/point_selector.hpp"
 
 namespace acvo {
 

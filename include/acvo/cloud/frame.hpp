@@ -5,7 +5,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "acvo/camera.hpp"
+#include "acvo/cloud/camera.hpp"
 
 namespace acvo {
 

@@ -11,14 +11,14 @@
 
 #include <Eigen/Geometry>
 
-#include "acvo/colour_depth_check.hpp"
-#include "acvo/covariance.hpp"
-#include "acvo/frame.hpp"
-#include "acvo/labelled_cloud.hpp"
+#include "acvo/cloud/colour_depth_check.hpp"
+#include "acvo/odometry/covariance.hpp"
+#include "acvo/cloud/frame.hpp"
+#include "acvo/cloud/labelled_cloud.hpp"
 #include "acvo/params.hpp"
-#include "acvo/registration.hpp"
-#include "acvo/se3.hpp"
-#include "acvo/velocity_changes.hpp"
+#include "acvo/registration/engine.hpp"
+#include "acvo/math/se3.hpp"
+#include "acvo/odometry/velocity_changes.hpp"
 
 namespace acvo {
 

@@ -14,9 +14,9 @@
 
 #include <Eigen/Geometry>
 
-#include "acvo/labelled_cloud.hpp"
+#include "acvo/cloud/labelled_cloud.hpp"
 #include "acvo/params.hpp"
-#include "acvo/se3.hpp"
+#include "acvo/math/se3.hpp"
 
 namespace acvo {
 

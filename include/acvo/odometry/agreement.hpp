@@ -6,7 +6,7 @@
 
 #include <Eigen/Geometry>
 
-#include "acvo/labelled_cloud.hpp"
+#include "acvo/cloud/labelled_cloud.hpp"
 
 namespace acvo {
 

@@ -14,7 +14,7 @@
 #include <Eigen/Core>
 
 #include "acvo/params.hpp"
-#include "acvo/se3.hpp"
+#include "acvo/math/se3.hpp"
 
 namespace acvo {
 
