@@ -2,7 +2,6 @@
 // HSV and gradient labels and colours.
 #include "acvo/cloud/labelled_cloud.hpp"
 
-#include <chrono>
 #include <cmath>
 #include <stdexcept>
 

@@ -3,7 +3,6 @@
 #include "acvo/odometry/odometry.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <sstream>
 

@@ -3,7 +3,6 @@
 #include "acvo/registration/coarse_to_fine.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <memory>
 #include <utility>

@@ -2,7 +2,6 @@
 #include "acvo/registration/kernel.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
 #include <utility>

@@ -3,7 +3,6 @@
 #include "acvo/registration/paper.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 
 #include "acvo/odometry/covariance.hpp"
