@@ -3,8 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <iomanip>
+#include <sstream>
 
 #include <diagnostic_msgs/DiagnosticStatus.h>
+#include <diagnostic_msgs/KeyValue.h>
 #include <tf2_eigen/tf2_eigen.h>
 
 #include "conversions.hpp"
@@ -61,11 +64,17 @@ acvo::OdometryInfo toInfoMsg(const acvo::OdometryResult& result, const std_msgs:
   info.status = acvo::toString(result.solver.status);
   info.iterations = result.solver.iterations;
   info.ell = result.solver.ell;
-  info.ell_at_bound = result.solver.ell_at_bound;
   info.fixed_points = static_cast<std::uint32_t>(result.fixed_points);
   info.moving_points = static_cast<std::uint32_t>(result.moving_points);
   info.nnz = result.solver.nnz;
-  info.inner_product = result.solver.inner_product;
+  for (const auto& [name, value] : acvo::engineFigures(result.solver)) {
+    diagnostic_msgs::KeyValue figure;
+    figure.key = name;
+    std::ostringstream text;
+    text << std::setprecision(9) << value;
+    figure.value = text.str();
+    info.engine_figures.push_back(figure);
+  }
   info.matched_fraction = result.solver.matched_fraction;
   info.frame_index = result.frame_index;
   info.keyframe_index = result.keyframe_index;

@@ -390,7 +390,8 @@ void OdometryNodelet::processFrame(const Image& rgb, const Image& depth, const I
   last_.message = r.message;
   last_.depth_delay = r.depth_delay;
   last_.depth_synced = r.depth_synced || r.depth_retimed;
-  last_.dense_weight = r.solver.dense_weight;
+  last_.dense_weight =
+      r.solver.coarse_to_fine ? r.solver.coarse_to_fine->dense_weight : std::nan("");
   if (last_.depth_synced && !depth_sync_told_) {
     depth_sync_told_ = true;
     NODELET_INFO("colour and depth stamps differ (%.1f ms on this frame): each frame's depth is "

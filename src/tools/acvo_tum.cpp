@@ -2,7 +2,6 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -73,6 +72,107 @@ std::optional<int> parseOptions(CLI::App& app, Options& o, int argc, char** argv
   return acvo::tools::parseCommandLine(app, argc, argv);
 }
 
+// What the intrinsics and lens of the folder are, on stderr: a calibration the user should know
+// is missing or taken from elsewhere.
+void noteCamera(const acvo::TumDataset& data) {
+  const acvo::Camera& c = data.camera();
+  if (data.distortion().any()) {
+    const auto& k = data.distortion().coefficients;
+    std::cerr << "acvo_tum: the camera's lens distortion (k1 k2 p1 p2 k3 = " << k[0] << ' '
+              << k[1] << ' ' << k[2] << ' ' << k[3] << ' ' << k[4]
+              << "): every frame undistorted on loading\n";
+  }
+  if (acvo::nominalIntrinsics(c, data.distortion())) {
+    std::cerr << "acvo_tum: note: the intrinsics (fx " << c.fx << ", fy " << c.fy << ", cx "
+              << c.cx << ", cy " << c.cy << ") are nominal, not a calibration: exact for a "
+              << "rendered camera; a real one's may be a few percent off, and acvo's translation "
+              << "carries that in full (--camera FILE gives a calibration; fr1, fr2 or fr3, "
+              << "TUM's)\n";
+  }
+  if (!data.namedCamera().empty()) {
+    std::cerr << "acvo_tum: note: no camera.yaml; the folder's name (" << data.namedCamera()
+              << ") gives TUM's calibrated intrinsics (fx " << c.fx << ", fy " << c.fy << ", cx "
+              << c.cx << ", cy " << c.cy << ")" << (data.distortion().any() ? " and lens" : "")
+              << " (--camera default or a camera file for others)\n";
+  }
+  if (c.mirrored()) {
+    std::cerr << "acvo_tum: note: a negative focal length (fx " << c.fx << ", fy " << c.fy
+              << "): that image axis runs against the optical frame's, as in ICL-NUIM's "
+              << "intrinsics (fy -480); pixels are back-projected with the signs given, and the "
+              << "trajectory is in the optical frame they define\n";
+  }
+}
+
+// --stats: one CSV line per frame; the last columns are the engine's own figures
+// (acvo::engineFigures), named for the engine in use.
+class StatsWriter {
+ public:
+  StatsWriter(const std::string& path, acvo::Engine engine) {
+    if (path.empty()) return;
+    out_.open(path);
+    if (!out_) throw std::runtime_error("cannot write " + path);
+    figures_ = engine == acvo::Engine::kPaper
+                   ? std::vector<std::string>{"ell_at_bound", "ell_max_reductions", "inner_product"}
+                   : std::vector<std::string>{"brightness_gain", "vignetting", "dense_weight"};
+    out_ << "frame,stamp,tracking,status,points,fixed_points,iterations,ell,nnz,matched_fraction,"
+            "ms_selection,ms_labels,ms_prepare,ms_cloud,ms_neighbours,ms_registration,ms_frame,"
+            "rss_kib,keyframe,new_keyframe,depth_delay_ms,depth_moved,second_start";
+    for (const auto& name : figures_) out_ << ',' << name;
+    out_ << '\n';
+  }
+  void write(long k, const std::string& stamp, const acvo::OdometryResult& r) {
+    if (!out_.is_open()) return;
+    const acvo::SolverResult& s = r.solver;
+    out_ << k << ',' << stamp << ',' << acvo::toString(r.tracking) << ','
+         << acvo::toString(s.status) << ',' << r.moving_points << ',' << r.fixed_points << ','
+         << s.iterations << ',' << s.ell << ',' << s.nnz << ',' << s.matched_fraction << ','
+         << r.cloud_stats.ms_selection << ',' << r.cloud_stats.ms_labels << ',' << r.ms_prepare
+         << ',' << r.ms_cloud << ',' << s.ms_neighbours << ',' << r.ms_registration << ','
+         << r.ms_cloud + r.ms_registration << ',' << acvo::tools::residentKiB() << ','
+         << r.keyframe_index << ',' << int(r.new_keyframe) << ',' << 1e3 * r.depth_delay << ','
+         << (r.depth_retimed ? 2 : int(r.depth_synced)) << ','
+         << (r.second_start_kept ? 2 : int(r.second_start));
+    const auto figures = acvo::engineFigures(s);
+    for (const auto& name : figures_) {
+      const auto it = std::find_if(figures.begin(), figures.end(),
+                                   [&](const auto& f) { return f.first == name; });
+      out_ << ',' << (it == figures.end() ? std::nan("") : it->second);
+    }
+    out_ << '\n';
+  }
+
+ private:
+  std::ofstream out_;
+  std::vector<std::string> figures_;
+};
+
+// The odometry's result for frame k, with what it says on stderr: the colour check's verdict,
+// and why a frame was lost or bad. nullopt when the frame could not be loaded.
+std::optional<acvo::OdometryResult> processFrame(acvo::Odometry& odometry,
+                                                 const acvo::TumDataset& data, long k,
+                                                 bool progress) {
+  acvo::OdometryResult r;
+  try {
+    r = odometry.process(data.loadFrame(std::size_t(k)));
+  } catch (const std::exception& e) {
+    std::cerr << "\nacvo_tum: frame " << k << " skipped: " << e.what() << "\n";
+    return std::nullopt;
+  }
+  const char* line = progress ? "\n" : "";
+  if (r.colour_verdict_now) {
+    const bool unregistered = odometry.colourCheck().verdict().state ==
+                              acvo::ColourDepthCheck::State::kUnregistered;
+    std::cerr << line << "acvo_tum: " << (unregistered ? "warning: " : "")
+              << odometry.describeColour() << "\n";
+  }
+  if (r.tracking == acvo::Tracking::kLost || r.tracking == acvo::Tracking::kBadFrame) {
+    std::cerr << line << "acvo_tum: frame " << k << " ("
+              << data.frames()[std::size_t(k)].rgb.stamp_text << "): "
+              << acvo::toString(r.tracking) << ": " << r.message << "\n";
+  }
+  return r;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -88,34 +188,7 @@ int main(int argc, char** argv) {
     }
     if (opt.threads >= 0) params.odometry.threads = opt.threads;
     const acvo::TumDataset data(opt.dataset, opt.camera);
-    if (data.distortion().any()) {
-      const auto& k = data.distortion().coefficients;
-      std::cerr << "acvo_tum: the camera's lens distortion (k1 k2 p1 p2 k3 = " << k[0] << ' '
-                << k[1] << ' ' << k[2] << ' ' << k[3] << ' ' << k[4]
-                << "): every frame undistorted on loading\n";
-    }
-    if (acvo::nominalIntrinsics(data.camera(), data.distortion())) {
-      const acvo::Camera& c = data.camera();
-      std::cerr << "acvo_tum: note: the intrinsics (fx " << c.fx << ", fy " << c.fy << ", cx "
-                << c.cx << ", cy " << c.cy << ") are nominal, not a calibration: exact for a "
-                << "rendered camera; a real one's may be a few percent off, and acvo's translation "
-                << "carries that in full (--camera FILE gives a calibration; fr1, fr2 or fr3, "
-                << "TUM's)\n";
-    }
-    if (!data.namedCamera().empty()) {
-      const acvo::Camera& c = data.camera();
-      std::cerr << "acvo_tum: note: no camera.yaml; the folder's name (" << data.namedCamera()
-                << ") gives TUM's calibrated intrinsics (fx " << c.fx << ", fy " << c.fy << ", cx "
-                << c.cx << ", cy " << c.cy << ")"
-                << (data.distortion().any() ? " and lens" : "")
-                << " (--camera default or a camera file for others)\n";
-    }
-    if (data.camera().mirrored()) {
-      std::cerr << "acvo_tum: note: a negative focal length (fx " << data.camera().fx << ", fy "
-                << data.camera().fy << "): that image axis runs against the optical frame's, as in "
-                << "ICL-NUIM's intrinsics (fy -480); pixels are back-projected with the signs "
-                << "given, and the trajectory is in the optical frame they define\n";
-    }
+    noteCamera(data);
     const std::string output =
         opt.output.empty() ? opt.dataset + "/acvo_trajectory.txt" : opt.output;
     const long first = std::min<long>(opt.start, long(data.size()));
@@ -125,81 +198,33 @@ int main(int argc, char** argv) {
       return acvo::tools::usageError(
           app, "no frames to process (dataset has " + std::to_string(data.size()) + ")");
     }
-
-    std::ofstream stats;
-    if (!opt.stats.empty()) {
-      stats.open(opt.stats);
-      if (!stats) throw std::runtime_error("cannot write " + opt.stats);
-      stats << "frame,stamp,tracking,status,points,fixed_points,iterations,ell,ell_at_bound,nnz,"
-               "inner_product,matched_fraction,ms_selection,ms_labels,ms_prepare,ms_cloud,ms_"
-               "neighbours,ms_step,ms_ell,"
-               "ms_registration,ms_frame,rss_kib,keyframe,new_keyframe,depth_delay_ms,"
-               "depth_moved,brightness_gain,"
-               "vignetting,dense_weight,second_start\n";
-    }
-
+    StatsWriter stats(opt.stats, params.registration.engine);
     acvo::Odometry odometry(params);
-    Eigen::Isometry3d world_from_first = Eigen::Isometry3d::Identity();
     if (data.groundtruth()) {
       const double stamp = data.frames()[std::size_t(first)].rgb.stamp;
       if (const auto* p = acvo::tools::nearestPose(*data.groundtruth(), stamp)) {
-        world_from_first = p->pose;
+        odometry.reset(p->pose);
       }
     }
-    odometry.reset(world_from_first);
-
     const bool progress = isatty(STDERR_FILENO);
     acvo::Trajectory trajectory;
     std::vector<double> frame_ms;
     long failures = 0;
     for (long k = first; k < last; ++k) {
       const auto& entry = data.frames()[std::size_t(k)];
-      acvo::OdometryResult r;
-      try {
-        const acvo::Frame frame = data.loadFrame(std::size_t(k));
-        r = odometry.process(frame);
-        if (r.colour_verdict_now) {
-          const bool unregistered = odometry.colourCheck().verdict().state ==
-                                    acvo::ColourDepthCheck::State::kUnregistered;
-          std::cerr << (progress ? "\n" : "") << "acvo_tum: " << (unregistered ? "warning: " : "")
-                    << odometry.describeColour() << "\n";
-        }
-      } catch (const std::exception& e) {
-        std::cerr << "\nacvo_tum: frame " << k << " skipped: " << e.what() << "\n";
-        ++failures;
-        continue;
+      const std::optional<acvo::OdometryResult> r = processFrame(odometry, data, k, progress);
+      failures += !r || r->tracking == acvo::Tracking::kLost ||
+                  r->tracking == acvo::Tracking::kBadFrame;
+      if (!r) continue;
+      if (r->tracking != acvo::Tracking::kBadFrame) {
+        trajectory.push_back({entry.rgb.stamp_text, entry.rgb.stamp, r->pose});
       }
-      const bool failed =
-          r.tracking == acvo::Tracking::kLost || r.tracking == acvo::Tracking::kBadFrame;
-      if (failed) {
-        ++failures;
-        std::cerr << (progress ? "\n" : "") << "acvo_tum: frame " << k << " ("
-                  << entry.rgb.stamp_text << "): " << acvo::toString(r.tracking) << ": "
-                  << r.message << "\n";
-      }
-      if (r.tracking != acvo::Tracking::kBadFrame) {
-        trajectory.push_back({entry.rgb.stamp_text, entry.rgb.stamp, r.pose});
-      }
-      const double ms = r.ms_cloud + r.ms_registration;
-      if (r.tracking != acvo::Tracking::kFirstFrame) frame_ms.push_back(ms);
-      if (stats.is_open()) {
-        const auto& s = r.solver;
-        stats << k << ',' << entry.rgb.stamp_text << ',' << acvo::toString(r.tracking) << ','
-              << acvo::toString(s.status) << ',' << r.moving_points << ',' << r.fixed_points << ','
-              << s.iterations << ',' << s.ell << ',' << int(s.ell_at_bound) << ',' << s.nnz << ','
-              << s.inner_product << ',' << s.matched_fraction << ',' << r.cloud_stats.ms_selection
-              << ',' << r.cloud_stats.ms_labels << ',' << r.ms_prepare << ',' << r.ms_cloud << ','
-              << s.ms_neighbours << ',' << s.ms_step << ',' << s.ms_ell << ',' << r.ms_registration
-              << ',' << ms << ',' << acvo::tools::residentKiB() << ',' << r.keyframe_index << ','
-              << int(r.new_keyframe) << ',' << 1e3 * r.depth_delay << ','
-              << (r.depth_retimed ? 2 : int(r.depth_synced)) << ',' << s.brightness_gain << ',' << s.vignetting
-              << ',' << s.dense_weight << ','
-              << (r.second_start_kept ? 2 : int(r.second_start))
-              << '\n';
-      }
+      const double ms = r->ms_cloud + r->ms_registration;
+      if (r->tracking != acvo::Tracking::kFirstFrame) frame_ms.push_back(ms);
+      stats.write(k, entry.rgb.stamp_text, *r);
       if (progress) {
         std::fprintf(stderr, "\racvo_tum: frame %ld/%ld  %3d it  %6.1f ms  %s    ", k - first + 1,
-                     last - first, r.solver.iterations, ms, acvo::toString(r.tracking).c_str());
+                     last - first, r->solver.iterations, ms, acvo::toString(r->tracking).c_str());
       }
     }
     if (progress) std::fprintf(stderr, "\n");

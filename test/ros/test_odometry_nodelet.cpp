@@ -586,10 +586,13 @@ TEST(OdometryNodelet, TracksKnownMotionWithRightFramesCovarianceAndTf) {
     const acvo::OdometryInfo& info = *out[k].info;
     const nav_msgs::Odometry& odom = *out[k].odom;
     EXPECT_TRUE(k == 0 ? info.tracking == "first_frame" : isTracking(info.tracking))
-        << info.tracking << ": " << info.message << " (inner product " << info.inner_product
-        << ", ell " << info.ell << (info.ell_at_bound ? " at a bound" : "") << ", "
+        << info.tracking << ": " << info.message << " (ell " << info.ell << ", "
         << info.iterations << " iterations)";
     EXPECT_FALSE(info.lost);
+    // The default engine's own figures, by name; none of the paper engine's.
+    std::vector<std::string> figures;
+    for (const auto& f : info.engine_figures) figures.push_back(f.key);
+    EXPECT_EQ(figures, (std::vector<std::string>{"brightness_gain", "vignetting", "dense_weight"}));
     EXPECT_EQ(odom.header.frame_id, client->odom_frame_);
     EXPECT_EQ(odom.child_frame_id, client->base_frame_);
     EXPECT_EQ(info.header.frame_id, acvo_ros::stripSlash(client->camera_frame_));

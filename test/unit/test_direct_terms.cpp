@@ -551,7 +551,7 @@ TEST(DirectTerms, TheEngineReportsTheDenseTermsWeight) {
     const auto A = prepareCoarseToFine(p.a, params, true);
     const auto B = prepareCoarseToFine(p.b, params, false);
     const double w =
-        alignCoarseToFine(*A, *B, Eigen::Isometry3d::Identity(), params).dense_weight;
+        alignCoarseToFine(*A, *B, Eigen::Isometry3d::Identity(), params).coarse_to_fine->dense_weight;
     if (dense) {
       EXPECT_EQ(w, B->images.grid.weight);
     }
@@ -579,8 +579,8 @@ TEST(DirectTerms, ALastLevelLedByTheDepthCountsThePlaneTermsWhateverTheNoise) {
   EXPECT_EQ(planeFadeNoise(plain), plain.depth_noise);
   EXPECT_EQ(planeFadeNoise(led), 0.0);
   const SolverResult a = align(plain), b = align(led);
-  EXPECT_EQ(a.dense_weight, 0.0);
-  EXPECT_EQ(b.dense_weight, 1.0);
+  EXPECT_EQ(a.coarse_to_fine->dense_weight, 0.0);
+  EXPECT_EQ(b.coarse_to_fine->dense_weight, 1.0);
   std::printf("  untextured room, noise in blobs: %.4f mm %.5f deg; led by the depth: %.4f mm "
               "%.5f deg\n",
               errorOf(a.transform).mm, errorOf(a.transform).deg, errorOf(b.transform).mm,

@@ -47,7 +47,9 @@ TEST(NumericFaults, CloudsOfIdenticalPointsGiveAStatusAndAFiniteTransform) {
                                         std::pair{&surface, &same}}) {
       const SolverResult r = alignClouds(*fixed, *moving);
       EXPECT_TRUE(r.transform.matrix().allFinite()) << toString(r.status);
-      EXPECT_TRUE(std::isfinite(r.inner_product)) << toString(r.status);
+      ASSERT_TRUE(r.coarse_to_fine);
+      EXPECT_TRUE(std::isfinite(r.coarse_to_fine->brightness_gain)) << toString(r.status);
+      EXPECT_TRUE(std::isfinite(r.coarse_to_fine->vignetting)) << toString(r.status);
       if (n < CoarseToFineParams().min_points) {
         EXPECT_EQ(r.status, SolverStatus::kTooFewPoints);
       }

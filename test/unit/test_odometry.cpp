@@ -470,7 +470,8 @@ TEST(Odometry, ColourFromASecondCameraLeavesTheLastLevelToTheDepth) {
       resampled = resampled || r.colour_resampled;
       if (i == 0) continue;  // the first frame registers nothing
       ASSERT_EQ(r.tracking, Tracking::kOk) << i;
-      EXPECT_EQ(r.solver.dense_weight, r.colour_resampled ? 1.0 : 0.0) << i;
+      ASSERT_TRUE(r.solver.coarse_to_fine);
+      EXPECT_EQ(r.solver.coarse_to_fine->dense_weight, r.colour_resampled ? 1.0 : 0.0) << i;
     }
     EXPECT_EQ(resampled, unregistered);
     EXPECT_EQ(odo.describeColour().find("led by the depth") != std::string::npos, unregistered)

@@ -226,7 +226,8 @@ TEST(Align, IdenticalCloudsGiveIdentityInZeroIterations) {
     EXPECT_EQ(r.status, SolverStatus::kConverged);
     EXPECT_EQ(r.iterations, 0);
     EXPECT_TRUE(r.transform.isApprox(Eigen::Isometry3d::Identity(), 1e-15));
-    EXPECT_NEAR(r.inner_product, 1.0, 1e-6);
+    ASSERT_TRUE(r.paper);
+    EXPECT_NEAR(r.paper->inner_product, 1.0, 1e-6);
   }
 }
 

@@ -10,6 +10,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -33,6 +34,29 @@ struct IterationTrace {
   std::int64_t nnz = 0;
 };
 
+// The default engine's own figures at its last iteration (registration/coarse_to_fine.hpp).
+struct CoarseToFineFigures {
+  // The photometric term's brightness of the moving frame against the reference's (its grey
+  // values are compared times this), and the vignetting it measured: exp(vignetting rho) the
+  // camera's falloff towards the corners, rho the squared distance from the principal point in
+  // focal lengths. 1 and 0 without the term.
+  double brightness_gain = 1.0;
+  double vignetting = 0.0;
+  // The dense point-to-plane term's weight (DepthGrid::weight: 0 where the depth's noise does
+  // not average away or its stamp is not the colour's); NaN with the term off.
+  double dense_weight = std::numeric_limits<double>::quiet_NaN();
+};
+
+// The paper engine's own figures (registration/paper.hpp).
+struct PaperFigures {
+  bool ell_at_bound = false;     // final ell pinned at ell_min or at the (shrunk) ell_max
+  int ell_bound_iterations = 0;  // iterations that ended with ell pinned at a bound
+  int ell_max_reductions = 0;    // times ell reached ell_max and the bound shrank
+  double inner_product = 0.0;    // <f_X, h.f_Z> / (|f_X| |f_Z|), in [0, 1]
+  double ms_step = 0.0;          // the step-size passes
+  double ms_ell = 0.0;           // the length-scale updates
+};
+
 // The outcome of one registration.
 struct SolverResult {
   // Maps points of the moving (current) cloud into the fixed (reference) cloud's frame.
@@ -51,29 +75,20 @@ struct SolverResult {
   // Why the engine found this registration hard to trust (empty when it did not): the
   // odometry judges such a frame hard to track.
   std::string hard;
-  // The paper engine's own diagnostics (zero for coarse_to_fine).
-  bool ell_at_bound = false;     // final ell pinned at ell_min or at the (shrunk) ell_max
-  int ell_bound_iterations = 0;  // iterations that ended with ell pinned at a bound
-  int ell_max_reductions = 0;    // times ell reached ell_max and the bound shrank
-  double inner_product = 0.0;    // <f_X, h.f_Z> / (|f_X| |f_Z|), in [0, 1]
-  int list_builds = 0;           // candidate-list rebuilds
-  // coarse_to_fine's photometric term: the moving frame's brightness against the reference's
-  // at the last iteration (its grey values are compared times this; 1 without the term).
-  double brightness_gain = 1.0;
-  // ... and the vignetting it measured: exp(vignetting rho) the camera's falloff towards the
-  // corners, rho the squared distance from the principal point in focal lengths (0 without).
-  double vignetting = 0.0;
-  // ... and its dense point-to-plane term's weight at the last level (DepthGrid::weight: 0 where
-  // the depth's noise does not average away or its stamp is not the colour's; NaN where the
-  // term is not part of the engine or is turned off).
-  double dense_weight = std::numeric_limits<double>::quiet_NaN();
+  int list_builds = 0;  // candidate-list rebuilds
+  // The figures of the engine that registered (the other is empty).
+  std::optional<CoarseToFineFigures> coarse_to_fine;
+  std::optional<PaperFigures> paper;
   std::vector<IterationTrace> trace;
   // Time per stage, milliseconds.
   double ms_total = 0.0;
   double ms_neighbours = 0.0;  // pair search, kernel and the sums of each iteration
-  double ms_step = 0.0;        // step-size pass (paper)
-  double ms_ell = 0.0;         // length-scale update (paper)
 };
+
+// The registering engine's own figures by name, for logs and messages: coarse_to_fine's
+// brightness_gain, vignetting and dense_weight, or the paper's ell_at_bound (0 or 1),
+// ell_max_reductions and inner_product; none when the engine did not run.
+std::vector<std::pair<std::string, double>> engineFigures(const SolverResult& s);
 
 enum class AlignStages { kAll, kCoarse, kFinest };
 

@@ -98,8 +98,8 @@ bool iterateLevel(LevelKernel& kernel, const LevelDirect& direct, double ell, do
     if (direct.reference) {
       Brightness brightness;
       const double to_units = addDirectTerms(s, ell, direct, p, T, H, g, brightness, planes);
-      result.brightness_gain = brightness.gain;
-      result.vignetting = brightness.vignetting;
+      result.coarse_to_fine->brightness_gain = brightness.gain;
+      result.coarse_to_fine->vignetting = brightness.vignetting;
       if (to_units > 0.0) result.hessian = -H / to_units;
     }
     result.ms_neighbours += msSince(t0);
@@ -180,6 +180,7 @@ SolverResult alignCoarseToFine(const CoarseToFineCloud& fixed, const CoarseToFin
                                AlignStages stages) {
   const auto t_start = Clock::now();
   SolverResult result;
+  result.coarse_to_fine.emplace();
   result.transform = guess;
   const std::vector<double> ells = levelElls(p);
   result.ell = ells.back();
@@ -218,7 +219,9 @@ SolverResult alignCoarseToFine(const CoarseToFineCloud& fixed, const CoarseToFin
     LevelDirect direct;
     if (last && directTerms(p) && fixed.images.isReference() && !moving.images.empty()) {
       direct = {&fixed.images, &moving.images, &moving.cloud, &fixed.cloud};
-      if (p.dense_point_to_plane) result.dense_weight = denseWeight(fixed.images, moving.images);
+      if (p.dense_point_to_plane) {
+        result.coarse_to_fine->dense_weight = denseWeight(fixed.images, moving.images);
+      }
     }
     if (!iterateLevel(*kernel, direct, ell, eps, last, p, T, result)) {
       result.status = SolverStatus::kNotFinite;

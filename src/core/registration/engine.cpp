@@ -28,9 +28,23 @@ SolverResult combinedStages(const SolverResult& coarse, SolverResult finest) {
   finest.trace.insert(finest.trace.begin(), coarse.trace.begin(), coarse.trace.end());
   finest.ms_total += coarse.ms_total;
   finest.ms_neighbours += coarse.ms_neighbours;
-  finest.ms_step += coarse.ms_step;
-  finest.ms_ell += coarse.ms_ell;
   return finest;
+}
+
+std::vector<std::pair<std::string, double>> engineFigures(const SolverResult& s) {
+  if (s.coarse_to_fine) {
+    const CoarseToFineFigures& f = *s.coarse_to_fine;
+    return {{"brightness_gain", f.brightness_gain},
+            {"vignetting", f.vignetting},
+            {"dense_weight", f.dense_weight}};
+  }
+  if (s.paper) {
+    const PaperFigures& f = *s.paper;
+    return {{"ell_at_bound", f.ell_at_bound ? 1.0 : 0.0},
+            {"ell_max_reductions", double(f.ell_max_reductions)},
+            {"inner_product", f.inner_product}};
+  }
+  return {};
 }
 
 std::optional<SolverStatus> inputProblem(const PreparedCloud& fixed, const PreparedCloud& moving,

@@ -30,17 +30,18 @@ void finish(PaperKernel& kernel, const PaperCloud& fixed, const PaperCloud& movi
             const Eigen::Isometry3d& guess, double final_ell, const LengthScale& ls,
             const PaperParams& p, SolverResult& result) {
   const bool adaptive = p.ell_policy == EllPolicy::kAdaptive;
-  result.ell_max_reductions = ls.reductions;
+  PaperFigures& figures = *result.paper;
+  figures.ell_max_reductions = ls.reductions;
   result.list_builds = kernel.listBuilds();
   const CrossSums& s = kernel.evaluate(result.transform, final_ell);
   result.ell = final_ell;
-  result.ell_at_bound = adaptive && ls.pinned(p);
+  figures.ell_at_bound = adaptive && ls.pinned(p);
   result.nnz = std::size_t(s.nnz);
   result.matched_fraction = double(s.matched) / double(std::max<std::size_t>(moving.size(), 1));
   result.objective = s.F;
   const SelfSums xx = selfKernelSums(fixed, final_ell, p);
   const SelfSums yy = selfKernelSums(moving, final_ell, p);
-  result.inner_product = xx.sum > 0 && yy.sum > 0 ? s.F / std::sqrt(xx.sum * yy.sum) : 0.0;
+  figures.inner_product = xx.sum > 0 && yy.sum > 0 ? s.F / std::sqrt(xx.sum * yy.sum) : 0.0;
   result.hessian = kernel.curvature();
   if (ls.reductions >= p.hard_ell_reductions) {
     result.hard = "length-scale kept reaching its upper bound (" +
@@ -94,6 +95,7 @@ SolverResult alignPaper(const PaperCloud& fixed, const PaperCloud& moving,
                         const Eigen::Isometry3d& guess, const PaperParams& p, double carried_ell) {
   const auto t_start = Clock::now();
   SolverResult result;
+  result.paper.emplace();
   result.transform = guess;
   result.ell = firstEll(p);
   if (const auto problem = inputProblem(fixed, moving, guess, p.min_points)) {
@@ -130,7 +132,7 @@ SolverResult alignPaper(const PaperCloud& fixed, const PaperCloud& moving,
     t0 = Clock::now();
     const StepSums st = kernel.stepSums(xi.head<3>(), xi.tail<3>());
     const double step = solveStep(st.B, st.C, st.D, st.E, p.min_step, p.max_step);
-    result.ms_step += msSince(t0);
+    result.paper->ms_step += msSince(t0);
     const Eigen::Isometry3d dT = expSE3(-step * xi);
     if (!dT.matrix().allFinite()) {
       result.status = SolverStatus::kNotFinite;
@@ -140,8 +142,8 @@ SolverResult alignPaper(const PaperCloud& fixed, const PaperCloud& moving,
     IterationTrace trace{used_ell, ls.ell_max, step, step * xi.norm(), s.F, s.nnz};
     if (adaptive) {
       t0 = Clock::now();
-      if (adaptEll(ls, fixed, moving, s, p)) ++result.ell_bound_iterations;
-      result.ms_ell += msSince(t0);
+      if (adaptEll(ls, fixed, moving, s, p)) ++result.paper->ell_bound_iterations;
+      result.paper->ms_ell += msSince(t0);
     }
     trace.ell_max = ls.ell_max;
     result.trace.push_back(trace);
