@@ -8,6 +8,8 @@
 #pragma once
 
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace acvo {
 
@@ -341,6 +343,13 @@ Params cvoParams();
 
 // The minimum cloud size of the engine in use.
 int minPoints(const Params& p);
+
+// Every parameter as (section + separator + name, its value as YAML writes it), in visitParams'
+// order: what a log shows.
+std::vector<std::pair<std::string, std::string>> paramTexts(const Params& p, char separator = '.');
+// "section<separator>name=value" for every parameter whose value differs between `from` and
+// `to`, separated by spaces (empty when none does).
+std::string describeChanges(const Params& from, const Params& to, char separator = '.');
 
 // Empty when the values are consistent; otherwise a message naming the offending parameter.
 std::string validate(const Params& p);

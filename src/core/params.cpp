@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <iomanip>
 #include <sstream>
 #include <stdexcept>
 #include <type_traits>
@@ -166,6 +167,34 @@ void fromString(const std::string& s, SyncDepth& v) {
 }
 void fromString(const std::string& s, UnregisteredColour& v) {
   enumFromString(s, v);
+}
+
+std::vector<std::pair<std::string, std::string>> paramTexts(const Params& p, char separator) {
+  std::vector<std::pair<std::string, std::string>> out;
+  visitParams(p, [&](const char* section, const char* name, const auto& v) {
+    std::ostringstream text;
+    text << std::setprecision(17);
+    using T = std::decay_t<decltype(v)>;
+    if constexpr (std::is_same_v<T, bool>) {
+      text << (v ? "true" : "false");
+    } else if constexpr (std::is_arithmetic_v<T>) {
+      text << v;
+    } else {
+      text << toString(v);
+    }
+    out.emplace_back(std::string(section) + separator + name, text.str());
+  });
+  return out;
+}
+
+std::string describeChanges(const Params& from, const Params& to, char separator) {
+  const auto a = paramTexts(from, separator), b = paramTexts(to, separator);
+  std::string out;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    if (a[k].second == b[k].second) continue;
+    out += (out.empty() ? "" : " ") + b[k].first + "=" + b[k].second;
+  }
+  return out;
 }
 
 std::string validate(const Params& p) {

@@ -131,22 +131,11 @@ std::vector<std::string> applyRosParams(const XmlRpc::XmlRpcValue& private_ns,
 }
 
 std::string describeParams(const acvo::Params& params) {
-  std::ostringstream out;
-  out << std::setprecision(17);
-  const char* separator = "";
-  visitParams(params, [&](const std::string& section, const std::string& name, const auto& v) {
-    out << separator << section << '/' << name << '=';
-    using T = std::decay_t<decltype(v)>;
-    if constexpr (std::is_same_v<T, bool>) {
-      out << (v ? "true" : "false");
-    } else if constexpr (std::is_arithmetic_v<T>) {
-      out << v;
-    } else {
-      out << acvo::toString(v);
-    }
-    separator = " ";
-  });
-  return out.str();
+  std::string out;
+  for (const auto& [name, value] : acvo::paramTexts(params, '/')) {
+    out += (out.empty() ? "" : " ") + name + "=" + value;
+  }
+  return out;
 }
 
 acvo::AcvoConfig toConfig(const acvo::Params& params, LostOdom lost_odom) {

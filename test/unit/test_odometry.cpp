@@ -476,7 +476,27 @@ TEST(Odometry, ColourFromASecondCameraLeavesTheLastLevelToTheDepth) {
     EXPECT_EQ(resampled, unregistered);
     EXPECT_EQ(odo.describeColour().find("led by the depth") != std::string::npos, unregistered)
         << odo.describeColour();
+    // The engine's parameters say so, and the log names what changed.
+    EXPECT_EQ(odo.engineParams().coarse_to_fine.depth_led, unregistered);
+    EXPECT_EQ(odo.engineParams().coarse_to_fine.photometric, !unregistered);
+    EXPECT_FALSE(odo.params().coarse_to_fine.depth_led);
+    EXPECT_EQ(odo.describeColour().find("the engine's parameters now: "
+                                        "coarse_to_fine/photometric=false "
+                                        "coarse_to_fine/depth_led=true") != std::string::npos,
+              unregistered)
+        << odo.describeColour();
   }
+  // With unregistered_colour resample, the colour alone: the engine as configured.
+  Params resample_only;
+  resample_only.odometry.unregistered_colour = UnregisteredColour::kResample;
+  o.colour_focal_ratio = 0.897;
+  const synth::SynthSequence seq(o);
+  Odometry odo(resample_only);
+  for (int i = 0; i < seq.size(); ++i) odo.process(seq.frame(i).toFrame());
+  ASSERT_TRUE(odo.colourResampling());
+  EXPECT_TRUE(odo.engineParams().coarse_to_fine.photometric);
+  EXPECT_FALSE(odo.engineParams().coarse_to_fine.depth_led);
+  EXPECT_EQ(odo.describeColour().find("engine's parameters"), std::string::npos);
 }
 
 TEST(Odometry, DeterministicForTheSameFramesWhateverTheThreadCount) {

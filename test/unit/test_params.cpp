@@ -327,3 +327,31 @@ TEST(Params, ValidateCatchesInconsistentValues) {
 
 }  // namespace
 }  // namespace acvo
+
+namespace acvo {
+namespace {
+
+// What a log shows: every parameter once, by section and name, and the ones that differ.
+TEST(Params, DescribeChangesNamesWhatDiffers) {
+  const Params p;
+  const auto texts = paramTexts(p, '/');
+  std::size_t fields = 0;
+  visitParams(p, [&](const char*, const char*, const auto&) { ++fields; });
+  ASSERT_EQ(texts.size(), fields);
+  EXPECT_EQ(texts.front().first, "selection/target_points");
+  EXPECT_EQ(texts.front().second, "4000");
+  EXPECT_EQ(describeChanges(p, p), "");
+  Params q = p;
+  q.coarse_to_fine.photometric = false;
+  q.coarse_to_fine.depth_noise = 0.001;
+  q.odometry.sync_depth = SyncDepth::kNone;
+  EXPECT_EQ(describeChanges(p, q),
+            "coarse_to_fine.depth_noise=0.001 coarse_to_fine.photometric=false "
+            "odometry.sync_depth=none");
+  EXPECT_EQ(describeChanges(q, p, '/'),
+            "coarse_to_fine/depth_noise=0.0025000000000000001 coarse_to_fine/photometric=true "
+            "odometry/sync_depth=own_motion");
+}
+
+}  // namespace
+}  // namespace acvo
