@@ -247,7 +247,7 @@ SolverResult Odometry::alignStaged(const Tracked& reference, Registration& reg,
   // The depth was moved to the colour's time by the last frame's motion (or not at all); the
   // stages before the finest find this frame's own, and the finest registers the depth moved by
   // that.
-  const SolverResult coarse = engine_->align(fixed, *reg.moving, guess, AlignStages::kCoarse);
+  SolverResult coarse = engine_->align(fixed, *reg.moving, guess, AlignStages::kCoarse);
   if (failed(coarse.status)) return coarse;
   const auto t0 = Clock::now();
   const Vector6d velocity = logSE3(reg.frameMotion(coarse.transform)) / r.interval;
