@@ -66,7 +66,7 @@ def log(who, message):
 # ------------------------------------------------------------------------------------------
 def build(who, log_dir=BENCH_OUT):
     """scripts/build (ACVO_JOBS defaults to nproc - 1), its output in log_dir/build.log; raises
-    ScriptError with the log's last lines when it fails."""
+    ScriptError with the last lines of that file when it fails."""
     os.makedirs(log_dir, exist_ok=True)
     build_log = os.path.join(log_dir, "build.log")
     env = dict(os.environ)

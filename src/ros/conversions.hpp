@@ -79,7 +79,7 @@ struct InputTopics {
   std::string rgb, depth, info;
 };
 
-// The intrinsics in use and where they come from, for the log and the diagnostics, e.g.
+// The intrinsics in use and where they come from, for /rosout and the diagnostics, e.g.
 // "fx 585, fy 585, cx 320, cy 240 (640x480) from camera_info on /camera/rgb/camera_info".
 std::string describeCamera(const acvo::Camera& camera, const IntrinsicsOverride& source,
                            const InputTopics& topics);

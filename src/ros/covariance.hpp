@@ -1,6 +1,6 @@
-// Covariances in ROS messages. The model lives in the core (acvo/covariance.hpp: the pose
-// covariance is the keyframe's plus the registration's to it, grown while lost); here only the
-// order of the blocks differs: the engine puts rotation first, geometry_msgs puts x y z first.
+// Covariances in ROS messages. The model lives in the core (acvo/odometry/covariance.hpp: the
+// pose covariance is the keyframe's plus the registration's to it, grown while lost); here only
+// the order of the blocks differs: the engine puts rotation first, geometry_msgs puts x y z first.
 #pragma once
 
 #include <array>

@@ -79,7 +79,7 @@ std::string closeMatchHint(const std::string& name, const std::vector<std::strin
 // finite numbers.
 std::optional<Eigen::Isometry3d> parsePose6(const std::string& text, std::string* problem);
 
-// One line for the log.
+// One line for /rosout.
 std::string describe(const NodeletSettings& settings);
 
 }  // namespace acvo_ros

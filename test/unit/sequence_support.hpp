@@ -95,8 +95,8 @@ inline void expectTheModelHelps(const synth::SynthSequence& seq, const Trajector
 }
 
 // The default without the dense depth term, for the models of the colour: with the renderer's
-// noise drawn per pixel the dense term carries much of the motion on its own (docs/accuracy.md,
-// thirteenth round), and what a model of the colour gains is measured with the colour leading.
+// noise drawn per pixel the dense term carries much of the motion on its own, and what a model
+// of the colour gains is measured with the colour leading.
 inline Params colourModelBase() {
   Params p;
   p.coarse_to_fine.dense_point_to_plane = false;

@@ -1,7 +1,7 @@
 // Whole rendered sequences under what a real camera does to its images, each model of the
 // camera against the default with it turned off: colour and depth of different instants, auto
 // exposure, motion blur, depth noise in blobs, colour from a second camera, vignetting. Bounds
-// are the measured figures with a margin (docs/accuracy.md).
+// are the figures measured here, with a margin.
 #include <array>
 #include <cstdio>
 
@@ -17,8 +17,8 @@ using namespace acvo::test;  // the sequences' helpers (sequence_support.hpp)
 // Colour taken 12 ms after the depth (unsynchronised streams, as a Kinect v1's or a
 // RealSense's), the camera at 0.5 m/s: the poses are the colour's, and each frame's depth is
 // moved to the colour's time (OdometryParams::sync_depth) by the last frame-to-frame motion, then
-// by the velocity filter's blend of that and the frame's own. Without it each point's colour is
-// of another instant than its position.
+// again, before the finest level, by the frame's own motion as the coarse levels found it.
+// Without it each point's colour is of another instant than its position.
 TEST(Sequences, UnsynchronisedColourAndDepthAreBroughtToOneInstant) {
   synth::SequenceOptions o;
   o.frames = 120;
@@ -35,8 +35,8 @@ TEST(Sequences, UnsynchronisedColourAndDepthAreBroughtToOneInstant) {
   Params unsynced;
   unsynced.odometry.sync_depth = SyncDepth::kNone;
   // Measured 0.00036 m/s, 0.0078 deg/s moved and 0.01509, 0.5213 as it came (150 frames of the
-  // same motion without the delay: 0.0003, 0.008; moved by the last frame's motion alone 0.00055,
-  // 0.0079; by the frame's own alone 0.00041, 0.0083).
+  // same motion without the delay: 0.0003, 0.008; moved by the last frame's motion alone,
+  // last_motion: 0.00055, 0.0079).
   expectTheModelHelps(seq, gt, Params(), unsynced, "depth moved to the colour's time",
                       "depth as it came", {0.00036, 0.0078}, 3.0);
 }
@@ -110,9 +110,8 @@ TEST(Sequences, DepthNoiseInBlobsAsARealKinectsCostsLittle) {
     EXPECT_EQ(b[p].lost, 0);
   }
   // Measured: per pixel 0.00075 m/s, 0.0173 deg/s (without the dense term 0.00120, 0.0239); in
-  // blobs 0.00120, 0.0257 either way (with the photometric term's forward direction alone
-  // 0.00080, 0.0174 (0.00156, 0.0258) and 0.00158, 0.0282, docs/accuracy.md thirty-first round;
-  // ICPOdometry loses its precision there: tenth round).
+  // blobs 0.00120, 0.0257 either way (with the photometric term's forward direction alone,
+  // reverse_photometric off: 0.00080, 0.0174 (0.00156, 0.0258) and 0.00158, 0.0282).
   EXPECT_LT(b[0].rpe.trans.rmse, 1.3 * 0.00120);
   EXPECT_LT(b[0].rpe.rot_deg.rmse, 1.3 * 0.0257);
   EXPECT_LT(a[0].rpe.trans.rmse, 1.3 * 0.00075);

@@ -104,7 +104,7 @@ TEST(ColourDepthCheck, AnUnregisteredColourCameraIsFoundWithItsFocalLength) {
 // grid, from 0.58 of ratio 1's at 0.89 to 1.2x at 1.20, with no peak at its camera's 0.897:
 // taken for a camera of ratio 1.20, its colour resampled by that cost acvo 3x in translation
 // (0.0253 -> 0.0804 m/s). A best ratio at the grid's ends (kGridEnd) is no camera found; the
-// search with the camera's centre climbs there too (1.19, 1 cm).
+// grid of cameras with their centres climbs there too (1.19, 1 cm).
 TEST(ColourDepthCheck, AScoreClimbingToTheGridsEndIsNoCamera) {
   synth::SequenceOptions o = exactRoom(0.897, 0.025);
   o.seed = 54;
@@ -152,11 +152,12 @@ ColourDepthCheck::Verdict judgeAsRegistered(const synth::SequenceOptions& o) {
 }
 
 // A hand-held camera at 0.8 m/s whose colour is taken 10 ms after its depth (free-running
-// streams): the raw pairs' colour edges lie off the depth edges by the motion, which once passed
-// for another colour camera (the focal ratio alone, every third frame: best 1.04, 1.18x the
-// score at 1). The odometry's own check, which sees the pairs as it registered them (the depth
-// moved to the colour's time: depthAsRegistered), finds them registered, and so does the search
-// of colour cameras on the raw pairs now (measured: its best camera 1.03, no baseline, 1.18x).
+// streams): the raw pairs' colour edges lie off the depth edges by the motion, which the focal
+// ratio alone takes for another colour camera (every third frame: best 1.04, 1.18x the score at
+// 1). The odometry's own check, which sees the pairs as it registered them (the depth moved to
+// the colour's time: depthAsRegistered), finds them registered, and so does the grid of colour
+// cameras with their centres on the raw pairs (measured: its best camera 1.03, no baseline,
+// 1.18x).
 TEST(ColourDepthCheck, AFastCameraWithLateColourIsNotTakenForUnregistered) {
   synth::SequenceOptions o;
   o.frames = 60;
@@ -182,7 +183,7 @@ TEST(ColourDepthCheck, AFastCameraWithLateColourIsNotTakenForUnregistered) {
 
 // A colour camera of 0.9 times the depth's focal length, 2.5 cm beside it, on a camera at 1 m/s
 // whose colour is blurred over half a frame: the blur spreads each silhouette's colour edge over
-// about 12 px, and the focal ratio alone then climbed to the grid's end (0.81, 1.09x the score at
+// about 12 px, and the focal ratio alone climbs to the grid's end (0.81, 1.09x the score at
 // 1: taken as registered, acvo 0.0114 m/s against 0.0016 resampled). The camera, found with its
 // centre, stands out (measured: 0.89, 3 cm, 1.20x; 1.21x in all quarters but one; every frame's
 // own best camera within 0.03 of it).
@@ -205,7 +206,7 @@ TEST(ColourDepthCheck, AColourCameraIsFoundThroughMotionBlur) {
 
 // A person walking across a registered camera's view: the colour 10 ms late moves the person's
 // colour off its silhouette by its own motion, which no colour camera explains in the whole
-// image (docs/accuracy.md, twenty-fourth round).
+// image.
 // - Walking at 0.5 m/s (p1), the best camera of the grid, 1.15 and 3 cm at 1.34x, passes the
 //   ratio's, the gain's and the frames' conditions and fits one quarter of the image only (1.01x
 //   in all quarters but one): the quarters tell it (and its focal ratio alone near it, 1.18, lies

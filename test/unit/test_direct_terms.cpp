@@ -341,7 +341,7 @@ TEST(DirectTerms, PointToPlaneFadesOutAsTheDepthNoiseReachesTheModelled) {
 }
 
 // The grid's windows see the renderer's Kinect-like noise drawn per pixel as independent, drawn in
-// 3-px blobs (a real structured-light camera's shape, docs/accuracy.md tenth round) as shared:
+// 3-px blobs (a real structured-light camera's shape, scripts/depth_noise) as shared:
 // the term is on for the first, off for the second; on exact depth it is on at full weight.
 TEST(DirectTerms, DenseGridTellsNoisePerPixelFromNoiseInBlobs) {
   const LabelledCloud per_pixel = renderedPair(false, true).a;

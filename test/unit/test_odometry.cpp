@@ -476,7 +476,7 @@ TEST(Odometry, ColourFromASecondCameraLeavesTheLastLevelToTheDepth) {
     EXPECT_EQ(resampled, unregistered);
     EXPECT_EQ(odo.describeColour().find("led by the depth") != std::string::npos, unregistered)
         << odo.describeColour();
-    // The engine's parameters say so, and the log names what changed.
+    // The engine's parameters say so, and the colour's description names what changed.
     EXPECT_EQ(odo.engineParams().coarse_to_fine.depth_led, unregistered);
     EXPECT_EQ(odo.engineParams().coarse_to_fine.photometric, !unregistered);
     EXPECT_FALSE(odo.params().coarse_to_fine.depth_led);

@@ -1,6 +1,6 @@
-// The order statistics the direct terms read (acvo/order_statistics.hpp): the answers of a sort,
-// on values in no order, with ties, all alike, already sorted or reversed, and on sizes either
-// side of where the narrowing pass starts.
+// The order statistics the direct terms read (acvo/math/order_statistics.hpp): the answers of a
+// sort, on values in no order, with ties, all alike, already sorted or reversed, and on sizes
+// either side of where the narrowing pass starts.
 #include <algorithm>
 #include <cstddef>
 #include <random>

@@ -1,7 +1,7 @@
 // Whole rendered sequences with a person in view (acvo_synth --walker): crossing, walking
 // slowly, entering, in view from the start, and a fast camera whose own acceleration must not be
 // taken for a person's pull. The second start (OdometryParams::second_start) against one start.
-// Bounds are the measured figures with a margin (docs/accuracy.md).
+// Bounds are the figures measured here, with a margin.
 #include <array>
 #include <cstdio>
 
@@ -28,8 +28,8 @@ TEST(Sequences, APersonCrossingTheViewIsNotMistakenForTheCamerasMotion) {
   one_start.odometry.second_start = false;
   // Measured 0.00032 m/s, 0.0060 deg/s with the second start and 0.469, 6.73 with one start
   // (0.00028, 0.0106 with the photometric term's forward direction alone; the room without the
-  // person: 0.0002, 0.005 over 300 frames, docs/accuracy.md; with Huber's weight in the direct
-  // terms, where the person's residuals kept pulling: 0.00102, 0.0267).
+  // person: 0.0002, 0.005 over 300 frames; with Huber's weight in the direct terms, where the
+  // person's residuals kept pulling: 0.00102, 0.0267).
   expectTheModelHelps(seq, groundtruthOf(seq), Params(), one_start, "a second start", "one start",
                       {0.00032, 0.0060}, 50.0);
 }
@@ -54,9 +54,9 @@ TEST(Sequences, ASlowPersonStaysOutOfTheOdometryOnceItWasCaughtPulling) {
   const auto runs = withAndWithoutSecondStart(slowWalker(), 170, 250);
   // Measured 0.00388 m/s, 0.1023 deg/s (0.00338, 0.0899 with the photometric term's forward
   // direction alone; with the two directions at equal shares 0.00821, 0.2031: the person, entering,
-  // pulled 4-6 mm a frame, under the check, docs/accuracy.md thirty-first round; 0.01003, 0.2470
-  // before the check below the jerk limits caught the frame 9 mm off as the person enters); with
-  // the plain margin after a kept second start 0.609, 8.53, and with one start 0.907, 12.7.
+  // pulled 4-6 mm a frame, under the check; without second_start_check 0.01003, 0.2470: the
+  // frame 9 mm off as the person enters); with the plain margin after a kept second start
+  // (second_start_memory off) 0.609, 8.53, and with one start 0.907, 12.7.
   EXPECT_LT(runs[0].rpe.trans.rmse, 1.3 * 0.00388);
   EXPECT_LT(runs[0].rpe.rot_deg.rmse, 1.3 * 0.1023);
   EXPECT_GT(runs[1].rpe.trans.rmse, 50.0 * runs[0].rpe.trans.rmse);
@@ -68,8 +68,8 @@ TEST(Sequences, ASlowPersonStaysOutOfTheOdometryOnceItWasCaughtPulling) {
 // (kSecondStartCheckSigmas) runs the second start, which holds the room and scores clearly higher.
 TEST(Sequences, APersonEnteringTheViewIsCaughtUnderTheJerkLimits) {
   const auto runs = withAndWithoutSecondStart(slowWalker(), 0, 60);
-  // Measured 0.00093 m/s, 0.0220 deg/s (0.00091, 0.0216 with p2 fixed at 1/12, docs/accuracy.md
-  // thirty-second round; 0.00259, 0.0564 with the photometric term's forward direction alone);
+  // Measured 0.00091 m/s, 0.0216 deg/s (0.00259, 0.0564 with the photometric term's forward
+  // direction alone);
   // with the jerk limits alone 0.0494, 1.49; with one start 0.644, 10.6.
   EXPECT_LT(runs[0].rpe.trans.rmse, 1.3 * 0.00093);
   EXPECT_LT(runs[0].rpe.rot_deg.rmse, 1.3 * 0.0220);
@@ -93,7 +93,7 @@ TEST(Sequences, APersonInViewFromTheStartIsToldFromTheRoom) {
   const auto runs = withAndWithoutSecondStart(synth::SynthSequence(o), 0, 45);
   // Measured 0.00101 m/s, 0.0376 deg/s (4 second starts, all kept; with the photometric term's
   // forward direction alone 0.00076, 0.0304, the reverse alone 0.00113, 0.0415: the reference's
-  // points on the person are sampled in every frame, docs/accuracy.md thirty-first round);
+  // points on the person are sampled in every frame);
   // without the start from the rest of the points 0.412, 2.36 (the guess held the person), with
   // one start 0.0772, 0.544.
   EXPECT_LT(runs[0].rpe.trans.rmse, 1.3 * 0.00101);
@@ -115,9 +115,9 @@ TEST(Sequences, AFastCamerasOwnAccelerationIsNotTakenForAPull) {
   o.speed = 0.8;
   o.seed = 23;
   const auto runs = withAndWithoutSecondStart(synth::SynthSequence(o), 0, 60);
-  // Measured 0.00138 m/s, 0.0304 deg/s (0.00144, 0.0315 with p2 fixed at 1/12; 0.00145, 0.0280
-  // with the photometric term's forward direction alone), as with one start, and 1 second start
-  // (its first frames' guess knows no velocity yet), none kept; with the floors alone (5 mm, 0.75 deg, no sigmas) and the plain
+  // Measured 0.00144 m/s, 0.0315 deg/s (0.00145, 0.0280 with the photometric term's forward
+  // direction alone), as with one start, and 1 second start (its first frames' guess knows no
+  // velocity yet), none kept; with the floors alone (5 mm, 0.75 deg, no sigmas) and the plain
   // margin (ties kept) 0.00929, 0.0332; with the floors alone and the 1.1x margin the same
   // figures, at 24 second starts.
   EXPECT_LT(runs[0].rpe.trans.rmse, 1.3 * 0.00138);

@@ -1,7 +1,7 @@
 // Whole sequences of the shared real Kinect frames (../shared/data: skipped where absent): the
 // default engine and the paper's A-CVO and CVO on 7-Scenes' kitchen and TUM fr3/teddy, against
-// their measured figures and the authors' code. Bounds are the measured figures with a margin
-// (docs/accuracy.md).
+// their measured figures and the authors' code. Bounds are the figures measured here, with a
+// margin.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -67,10 +67,10 @@ TEST(Sequences, RpeOnRealKinectFrames) {
     std::printf("  kitchen7s_dev %-14s RPE %.4f m/s %.3f deg/s, %d lost\n", kRunNames[p],
                 runs[p].rpe.trans.rmse, runs[p].rpe.rot_deg.rmse, runs[p].lost);
   }
-  // Measured 0.0135 m/s, 0.709 deg/s (default: its colour found unregistered and resampled,
-  // docs/accuracy.md, fifteenth round, and from then on the last level led by the depth,
-  // twenty-ninth round: 0.0321, 1.868 without); paper.yaml 0.0628 m/s, 4.479 deg/s; cvo.yaml
-  // 0.0893, 5.474. Bounds 1.1x. 7-Scenes colour and depth come from two unregistered cameras.
+  // Measured 0.0135 m/s, 0.709 deg/s (default: its colour found unregistered, then resampled and
+  // the last level led by the depth, unregistered_colour resample_depth_led; 0.0321, 1.868 with
+  // resample alone); paper.yaml 0.0628 m/s, 4.479 deg/s; cvo.yaml 0.0893, 5.474. Bounds 1.1x.
+  // 7-Scenes colour and depth come from two unregistered cameras.
   EXPECT_EQ(runs[0].lost, 0);
   EXPECT_LT(runs[0].rpe.trans.rmse, 0.0151);
   EXPECT_LT(runs[0].rpe.rot_deg.rmse, 0.785);
@@ -83,7 +83,8 @@ TEST(Sequences, RpeOnRealKinectFrames) {
 // TUM fr3/teddy (200 frames, hand-held, up to 100 deg/s) with motion-capture ground truth: the
 // default engine within a margin of its measured figures, nothing lost, and well below the
 // drift of the same engine registering frame to frame. (OpenCV's RgbdOdometry set up as its
-// TUM sample, at 10 m, does better here: 0.0104 m/s, 0.496 deg/s; docs/accuracy.md.)
+// TUM sample, at 10 m, does better here: 0.0104 m/s, 0.496 deg/s; docs/accuracy.md's engines
+// table.)
 TEST(Sequences, RealHandHeldMotionIsTrackedWithoutLossOrDrift) {
   const auto shared = test::sharedDataDir();
   if (shared.empty()) GTEST_SKIP() << "../shared/data not present";
@@ -101,11 +102,9 @@ TEST(Sequences, RealHandHeldMotionIsTrackedWithoutLossOrDrift) {
       "  tum_fr3_teddy200 default RPE %.4f m/s %.3f deg/s, ATE %.4f m (frame to frame "
       "%.4f m), %d lost\n",
       rpe.trans.rmse, rpe.rot_deg.rmse, ate, ate_previous, runs[0].lost);
-  // Measured 0.0057 m/s, 0.447 deg/s; ATE 0.0061 m against 0.0153 m frame to frame (p2 fixed at
-  // 1/12: 0.0057, 0.449, ATE 0.0060, docs/accuracy.md thirty-second round; the photometric
-  // term's forward direction alone: 0.0059, 0.470, ATE 0.0061, thirty-first round; the kernel
-  // alone: 0.0086, 0.579, ATE 0.0105; max_depth 4: 0.0159, 1.066,
-  // ATE 0.0185). Bounds 1.3x.
+  // Measured 0.0057 m/s, 0.449 deg/s; ATE 0.0060 m against 0.0153 m frame to frame (the
+  // photometric term's forward direction alone: 0.0059, 0.470, ATE 0.0061; the kernel alone:
+  // 0.0086, 0.579, ATE 0.0105; max_depth 4: 0.0159, 1.066, ATE 0.0185). Bounds 1.3x.
   EXPECT_EQ(runs[0].lost, 0);
   EXPECT_LT(rpe.trans.rmse, 0.0074);
   EXPECT_LT(rpe.rot_deg.rmse, 0.581);
@@ -113,8 +112,8 @@ TEST(Sequences, RealHandHeldMotionIsTrackedWithoutLossOrDrift) {
   EXPECT_LT(ate, 0.7 * ate_previous);
   // The camera's stamps against the motion capture's clock: both modes' frame-to-frame turns
   // agree best with the reference's 12-13 ms before the stamps (RgbdOdometry's too;
-  // docs/accuracy.md, thirtieth round), and there the 1-s windows lose a seventh of their
-  // rotation error.
+  // docs/accuracy.md, "The reference's clock"), and there the 1-s windows lose a seventh of
+  // their rotation error.
   const ClockOffset clock = estimateClockOffset(gt, {runs[0].estimate, runs[1].estimate});
   const RpeResult at_clock =
       computeRpe(gt, runs[0].estimate, 1.0, DeltaUnit::kSeconds, clock.offset);

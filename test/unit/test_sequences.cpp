@@ -1,7 +1,7 @@
 // Whole sequences: RPE over 1 s on synthetic 300-frame sequences (Kinect-like noise) in the
 // TUM structure/texture conditions for the default engine (coarse_to_fine) and the paper's A-CVO
 // and CVO (paperParams(), cvoParams()); frames missing, blank or with nothing to track, and a
-// fast rotation. Bounds are the measured figures with a margin (docs/accuracy.md). The other
+// fast rotation. Bounds are the figures measured here, with a margin. The other
 // whole-sequence tests: test_real_sequences (the shared real frames), test_camera_conditions
 // (what a real camera does to its images), test_people (a person in view), test_keyframe_drift
 // (a camera standing still or swaying).
@@ -68,11 +68,10 @@ INSTANTIATE_TEST_SUITE_P(StructureTexture, Sequences,
                          // level's direct terms, the dense one on: this renderer draws its
                          // noise per pixel): 0.00036/0.0083, 0.00070/0.0176, 0.00021/0.0063
                          // (0.00038/0.0088, 0.00074/0.0185, 0.00022/0.0066 with the
-                         // photometric term's forward direction alone, docs/accuracy.md
-                         // thirty-first round; without the dense term 0.00055/0.0115, 0.00200/0.0441,
-                         // 0.00019/0.0054: on a single plane it pins 3 of 6 directions and
-                         // outweighs a photometric term more precise than it says,
-                         // docs/accuracy.md thirteenth round; the kernel alone: 0.0024/0.062,
+                         // photometric term's forward direction alone; without the dense
+                         // term 0.00055/0.0115, 0.00200/0.0441, 0.00019/0.0054: on a single
+                         // plane it pins 3 of 6 directions and outweighs a photometric term
+                         // more precise than it says; the kernel alone: 0.0024/0.062,
                          // 0.0047/0.134, 0.0013/0.042; frame to frame it was 0.0078/0.208,
                          // 0.0129/0.300, 0.0032/0.174); paper.yaml (the authors' settings):
                          // 0.0151/0.423, 0.0436/0.981, 0.0052/0.183; cvo.yaml 0.0340/0.855,
@@ -120,10 +119,9 @@ TEST(Sequences, EveryOtherFrameMissingStillTracks) {
   EXPECT_TRUE(allFinite(run.estimate));
   EXPECT_EQ(run.lost, 0);
   // Measured 0.00033 m/s, 0.0075 deg/s (0.00039, 0.0092 with the photometric term's forward
-  // direction alone; without the dense depth term 0.00031, 0.0065: a
-  // textured room, where it outweighs a photometric term more precise than it says,
-  // docs/accuracy.md thirteenth round; the kernel alone 0.0024, 0.064; frame to frame 0.0063,
-  // 0.143); bounds 1.3x.
+  // direction alone; without the dense depth term 0.00031, 0.0065: a textured room, where it
+  // outweighs a photometric term more precise than it says; the kernel alone 0.0024, 0.064;
+  // frame to frame 0.0063, 0.143); bounds 1.3x.
   EXPECT_LT(run.rpe.trans.rmse, 0.00043);
   EXPECT_LT(run.rpe.rot_deg.rmse, 0.0098);
 }
@@ -184,9 +182,9 @@ void runBlackout(Blank kind) {
   // and is judged ok (0.12 mm, 0.0027 deg off); the error from before the blackout to 2 s after
   // it is 0.76 mm, 0.0168 deg; RPE after it 0.00028 m/s, 0.0056 deg/s (with the photometric
   // term's forward direction alone 0.18 mm, 0.0041 deg; 0.69 mm, 0.0179 deg; 0.00024, 0.0065;
-  // the kernel alone: 0.026 m, 0.65 deg; 0.0103 m/s, 0.309 deg/s). Bounds 1.3x. (A motion beyond the registration's reach
-  // would make that frame lost and the reference restart from it: the error would then be the
-  // blackout's motion.)
+  // the kernel alone: 0.026 m, 0.65 deg; 0.0103 m/s, 0.309 deg/s). Bounds 1.3x. (A motion beyond
+  // the registration's reach would make that frame lost and the reference restart from it: the
+  // error would then be the blackout's motion.)
   EXPECT_LT(across_t, 0.00099);
   EXPECT_LT(across_r, 0.0218);
   EXPECT_LT(rpe_after.trans.rmse, 0.00036);
@@ -247,8 +245,8 @@ TEST(Sequences, ATurnsJumpIsNotTakenForASidewaysMove) {
   const auto runs = withAndWithoutSecondStart(synth::SynthSequence(o), 0, 45);
   // Measured 9.0e-6 m/s, 0.00032 deg/s (6 second starts kept of 16), with one start 0.0596,
   // 0.00038: the first start took the jump for a move. With the dense term's points 10 px apart
-  // on exact depth as well (before the thirty-fifth round, docs/accuracy.md) 0.00019, 0.0081 (3
-  // kept), with one start 0.0641, 0.0005, and without the turn's start 0.0641, 0.0104.
+  // on exact depth as well (exact_depth_grid_stride 10) 0.00019, 0.0081 (3 kept), with one start
+  // 0.0641, 0.0005, and without the turn's start (turn_start off) 0.0641, 0.0104.
   EXPECT_LT(runs[0].rpe.trans.rmse, 1.3 * 9.04e-6);
   EXPECT_LT(runs[0].rpe.rot_deg.rmse, 1.3 * 0.000323);
   EXPECT_GT(runs[1].rpe.trans.rmse, 50.0 * runs[0].rpe.trans.rmse);

@@ -53,8 +53,9 @@ LensDistortion distortionByName(const std::string& name);
 // lengths, the principal point at the image's centre (w/2, (w-1)/2 or (w+1)/2 across, the
 // conventions datasets, drivers and simulators use, and likewise down) and no lens distortion.
 // Exact for a simulated camera; for a real one, a driver's or a dataset's defaults are a few
-// percent off, which a registration of the depth's geometry carries in full (docs/accuracy.md,
-// twentieth round). A calibration never lands on all of these to the millionth of a pixel.
+// percent off, which a registration of the depth's geometry carries in full (`acvo_compare
+// --camera` measures a folder's sensitivity). A calibration never lands on all of these to the
+// millionth of a pixel.
 bool nominalIntrinsics(const Camera& camera, const LensDistortion& distortion);
 
 // What a camera.yaml says: the pinhole intrinsics and the lens they were calibrated with.

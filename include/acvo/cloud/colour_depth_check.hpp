@@ -3,7 +3,7 @@
 // Kinect-type driver (depth_registration off, 7-Scenes' recordings) comes from a second camera
 // with another focal length (the Kinect's colour camera 525 px, its depth camera 585): the
 // colour then lies up to 30 px off its point at the image border, and every colour method
-// suffers (docs/accuracy.md: a rendered room, acvo 0.0004 -> 0.034 m/s).
+// suffers (docs/accuracy.md: the rendered room whose colour is unregistered).
 //
 // The evidence: where the depth jumps (an object's silhouette) the colour nearly always changes
 // too. Per frame, the colour image's gradient magnitude (Sobel, smoothed by a 1-px Gaussian,
@@ -16,9 +16,9 @@
 // depth edges, a registered pair scores best at ratio 1 (TUM fr3/teddy: 1.01, 1.03x the score
 // at 1), an unregistered one away from it (7-Scenes' kitchen: 0.90 and 3 cm, 1.8x; rendered
 // cameras of 0.9 and 2.5 cm: 0.86-0.94, 1.2-2.7x). The baseline's shift differs from silhouette to
-// silhouette by their depths, which a texture does not mimic; without it in the grid (as the
-// verdict once rested on the ratio alone) the camera's baseline blurs the ratio's peak, and a
-// colour camera on a fast, blurred camera went unseen (docs/accuracy.md, twenty-fourth round).
+// silhouette by their depths, which a texture does not mimic; judged by the ratio alone, the
+// cameras' baseline blurs the ratio's peak, and a colour camera on a fast, blurred camera goes
+// unseen (ColourDepthCheck.AColourCameraIsFoundThroughMotionBlur).
 // The verdict "unregistered" asks of the best camera of the grid: its ratio not at the grid's
 // ends (kGridEnd) and min_offset from 1; min_gain over a camera in the depth camera's place; the
 // same in all quarters of the image but one (min_quarter_gain: a person's colour late on its
@@ -71,8 +71,8 @@ class ColourDepthCheck {
     double min_agreement = 0.6;    // ... and this fraction of the frames' own best camera's
     double agreement_within = 0.03;  // ratio within this of its ratio
     double max_baseline = 0.06;    // m: the colour camera's centre searched within this along x
-    int max_edges_per_frame = 1000;  // the grid and the search read every k-th edge pixel of a
-                                     // frame, k = edges / this (rounded down)
+    int max_edges_per_frame = 1000;  // the grid reads every k-th edge pixel of a frame,
+                                     // k = edges / this (rounded down)
   };
 
   enum class State { kUndecided, kRegistered, kUnregistered };
@@ -82,7 +82,7 @@ class ColourDepthCheck {
     // The colour focal length over the depth's that fits best alone (no baseline, every edge
     // pixel) within agreement_within of grid_ratio: the default resampling's.
     double best_ratio = 1.0;
-    // The camera of the search's grid (focal ratio by 0.01, centre by kBaselineStep) that fits
+    // The camera of the grid (focal ratio by 0.01, centre by kBaselineStep) that fits
     // best, and its score over the score of a camera in the depth camera's place.
     double grid_ratio = 1.0;
     double grid_baseline = 0.0;
