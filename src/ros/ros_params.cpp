@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <type_traits>
 
+#include <dynamic_reconfigure/Config.h>
+
 namespace acvo_ros {
 namespace {
 
@@ -138,64 +140,86 @@ std::string describeParams(const acvo::Params& params) {
   return out;
 }
 
+namespace {
+
+// The reconfigure name of a parameter: its key, the paper section's with a paper_ prefix
+// (dynamic_reconfigure's names are one flat namespace). The .cfg is the one table of what is
+// reconfigurable; these two functions carry every parameter it names, by that name.
+std::string reconfigureName(const std::string& section, const std::string& key) {
+  return section == "paper" ? "paper_" + key : key;
+}
+
+template <typename Entry, typename Value>
+void put(std::vector<Entry>& entries, const std::string& name, const Value& value) {
+  Entry e;
+  e.name = name;
+  e.value = value;
+  entries.push_back(e);
+}
+
+template <typename Entry>
+const Entry* entryNamed(const std::vector<Entry>& entries, const std::string& name) {
+  for (const Entry& e : entries) {
+    if (e.name == name) return &e;
+  }
+  return nullptr;
+}
+
+}  // namespace
+
 acvo::AcvoConfig toConfig(const acvo::Params& params, LostOdom lost_odom) {
-  acvo::AcvoConfig c = acvo::AcvoConfig::__getDefault__();
-  c.target_points = params.selection.target_points;
-  c.min_depth = params.selection.min_depth;
-  c.max_depth = params.selection.max_depth;
-  c.engine = acvo::toString(params.registration.engine);
-  c.ell_init = params.coarse_to_fine.ell_init;
-  c.ell_min = params.coarse_to_fine.ell_min;
-  c.color_ell = params.coarse_to_fine.color_ell;
-  c.depth_noise = params.coarse_to_fine.depth_noise;
-  c.level_iterations = params.coarse_to_fine.level_iterations;
-  c.photometric = params.coarse_to_fine.photometric;
-  c.point_to_plane = params.coarse_to_fine.point_to_plane;
-  c.dense_point_to_plane = params.coarse_to_fine.dense_point_to_plane;
-  c.photometric_gain = params.coarse_to_fine.photometric_gain;
-  c.photometric_vignetting = params.coarse_to_fine.photometric_vignetting;
-  c.exposure_time = params.coarse_to_fine.exposure_time;
-  c.paper_ell_policy = acvo::toString(params.paper.ell_policy);
-  c.paper_ell_init = params.paper.ell_init;
-  c.paper_ell_min = params.paper.ell_min;
-  c.paper_ell_max = params.paper.ell_max;
-  c.paper_color_ell = params.paper.color_ell;
-  c.paper_max_iterations = params.paper.max_iterations;
-  c.initial_guess = acvo::toString(params.odometry.initial_guess);
-  c.sync_depth = acvo::toString(params.odometry.sync_depth);
-  c.unregistered_colour = acvo::toString(params.odometry.unregistered_colour);
-  c.second_start = params.odometry.second_start;
-  c.lost_odom = toString(lost_odom);
-  return c;
+  dynamic_reconfigure::Config msg;
+  acvo::visitParams(params, [&](const std::string& section, const std::string& key,
+                                const auto& field) {
+    using T = std::decay_t<decltype(field)>;
+    const std::string name = reconfigureName(section, key);
+    if constexpr (std::is_same_v<T, bool>) {
+      put(msg.bools, name, field);
+    } else if constexpr (std::is_same_v<T, int>) {
+      put(msg.ints, name, field);
+    } else if constexpr (std::is_same_v<T, double>) {
+      put(msg.doubles, name, field);
+    } else {
+      put(msg.strs, name, acvo::toString(field));
+    }
+  });
+  put(msg.strs, "lost_odom", toString(lost_odom));
+  // Takes the entries the .cfg names and ignores the rest.
+  acvo::AcvoConfig config = acvo::AcvoConfig::__getDefault__();
+  config.__fromMessage__(msg);
+  return config;
 }
 
 acvo::Params fromConfig(const acvo::AcvoConfig& config, acvo::Params base) {
-  base.selection.target_points = config.target_points;
-  base.selection.min_depth = config.min_depth;
-  base.selection.max_depth = config.max_depth;
-  acvo::fromString(config.engine, base.registration.engine);
-  base.coarse_to_fine.ell_init = config.ell_init;
-  base.coarse_to_fine.ell_min = config.ell_min;
-  base.coarse_to_fine.color_ell = config.color_ell;
-  base.coarse_to_fine.depth_noise = config.depth_noise;
-  base.coarse_to_fine.level_iterations = config.level_iterations;
-  base.coarse_to_fine.photometric = config.photometric;
-  base.coarse_to_fine.point_to_plane = config.point_to_plane;
-  base.coarse_to_fine.dense_point_to_plane = config.dense_point_to_plane;
-  base.coarse_to_fine.photometric_gain = config.photometric_gain;
-  base.coarse_to_fine.photometric_vignetting = config.photometric_vignetting;
-  base.coarse_to_fine.exposure_time = config.exposure_time;
-  acvo::fromString(config.paper_ell_policy, base.paper.ell_policy);
-  base.paper.ell_init = config.paper_ell_init;
-  base.paper.ell_min = config.paper_ell_min;
-  base.paper.ell_max = config.paper_ell_max;
-  base.paper.color_ell = config.paper_color_ell;
-  base.paper.max_iterations = config.paper_max_iterations;
-  acvo::fromString(config.initial_guess, base.odometry.initial_guess);
-  acvo::fromString(config.sync_depth, base.odometry.sync_depth);
-  acvo::fromString(config.unregistered_colour, base.odometry.unregistered_colour);
-  base.odometry.second_start = config.second_start;
+  dynamic_reconfigure::Config msg;
+  config.__toMessage__(msg);
+  acvo::visitParams(base, [&](const std::string& section, const std::string& key, auto& field) {
+    using T = std::decay_t<decltype(field)>;
+    const std::string name = reconfigureName(section, key);
+    if constexpr (std::is_same_v<T, bool>) {
+      if (const auto* e = entryNamed(msg.bools, name)) field = e->value != 0;
+    } else if constexpr (std::is_same_v<T, int>) {
+      if (const auto* e = entryNamed(msg.ints, name)) field = e->value;
+    } else if constexpr (std::is_same_v<T, double>) {
+      if (const auto* e = entryNamed(msg.doubles, name)) field = e->value;
+    } else {
+      if (const auto* e = entryNamed(msg.strs, name)) acvo::fromString(e->value, field);
+    }
+  });
   return base;
+}
+
+std::vector<std::string> reconfigureNamesWithoutParameter() {
+  std::set<std::string> names;
+  acvo::visitParams(acvo::Params(), [&](const std::string& section, const std::string& key,
+                                        const auto&) {
+    names.insert(reconfigureName(section, key));
+  });
+  std::vector<std::string> missing;
+  for (const auto& d : acvo::AcvoConfig::__getParamDescriptions__()) {
+    if (d->name != "lost_odom" && !names.count(d->name)) missing.push_back(d->name);
+  }
+  return missing;
 }
 
 }  // namespace acvo_ros

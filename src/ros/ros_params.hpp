@@ -25,10 +25,14 @@ std::vector<std::string> applyRosParams(const XmlRpc::XmlRpcValue& private_ns,
 // "section/name=value ..." for every parameter: logged at start and compared to detect a change.
 std::string describeParams(const acvo::Params& params);
 
-// The dynamic_reconfigure view of the parameters it exposes.
+// The dynamic_reconfigure view of the parameters cfg/Acvo.cfg exposes: each by its key (the
+// paper section's as paper_KEY), lost_odom from the nodelet's settings.
 acvo::AcvoConfig toConfig(const acvo::Params& params, LostOdom lost_odom);
 // The parameters with the reconfigurable ones taken from `config`. Throws
 // std::invalid_argument for an unknown enum string.
 acvo::Params fromConfig(const acvo::AcvoConfig& config, acvo::Params base);
+// The names of cfg/Acvo.cfg that name no parameter (but lost_odom): a typo there would leave an
+// option that changes nothing.
+std::vector<std::string> reconfigureNamesWithoutParameter();
 
 }  // namespace acvo_ros

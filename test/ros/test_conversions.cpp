@@ -636,6 +636,17 @@ TEST(RosParams, ReconfigureRoundTripsAndDescribesEveryParameter) {
   EXPECT_EQ(std::count(d.begin(), d.end(), '='), count);
 }
 
+TEST(RosParams, EveryReconfigureOptionNamesAParameter) {
+  EXPECT_EQ(reconfigureNamesWithoutParameter(), std::vector<std::string>{});
+  // The paper section's by their prefix, the others by their key alone.
+  acvo::Params p;
+  p.paper.max_iterations = 77;
+  p.coarse_to_fine.level_iterations = 5;
+  const acvo::AcvoConfig c = toConfig(p, LostOdom::kHeld);
+  EXPECT_EQ(c.paper_max_iterations, 77);
+  EXPECT_EQ(c.level_iterations, 5);
+}
+
 TEST(RosParams, ReconfigureDefaultsAreTheCoreDefaults) {
   // rqt_reconfigure shows the .cfg defaults as "default": they must be acvo::Params'.
   const acvo::Params defaults;
