@@ -172,8 +172,8 @@ void BM_LevelKernelWarm(benchmark::State& state) {
 }
 BENCHMARK(BM_LevelKernelWarm)->Apply(levelArguments);
 
-// Writes over 64 MB, twice the last-level cache of the machines docs/benchmarks.md was measured
-// on (a CPU with a larger one keeps more), so that the next read of the images starts from main
+// Writes over 64 MB, more than the last-level cache of most machines (a CPU with a larger one
+// keeps more), so that the next read of the images starts from main
 // memory, as it does in a frame after other work (another odometry, the driver, the next frame's
 // decoding) has run.
 void evictCaches() {
