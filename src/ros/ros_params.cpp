@@ -211,10 +211,9 @@ acvo::Params fromConfig(const acvo::AcvoConfig& config, acvo::Params base) {
 
 std::vector<std::string> reconfigureNamesWithoutParameter() {
   std::set<std::string> names;
-  acvo::visitParams(acvo::Params(), [&](const std::string& section, const std::string& key,
-                                        const auto&) {
-    names.insert(reconfigureName(section, key));
-  });
+  const acvo::Params defaults;
+  acvo::visitParams(defaults, [&](const std::string& section, const std::string& key,
+                                  const auto&) { names.insert(reconfigureName(section, key)); });
   std::vector<std::string> missing;
   for (const auto& d : acvo::AcvoConfig::__getParamDescriptions__()) {
     if (d->name != "lost_odom" && !names.count(d->name)) missing.push_back(d->name);
