@@ -120,6 +120,33 @@ bool iterateLevel(LevelKernel& kernel, const LevelDirect& direct, double ell, do
   return true;
 }
 
+// The direct terms of a level: the last level's, where the terms are on, the fixed cloud has a
+// reference's images and the moving cloud its own (with the dense term's weight in `result`).
+LevelDirect levelDirect(const CoarseToFineCloud& fixed, const CoarseToFineCloud& moving,
+                        const CoarseToFineParams& p, bool last, SolverResult& result) {
+  LevelDirect direct;
+  if (last && directTerms(p) && fixed.images.isReference() && !moving.images.empty()) {
+    direct = {&fixed.images, &moving.images, &moving.cloud, &fixed.cloud};
+    if (p.dense_point_to_plane) {
+      result.coarse_to_fine->dense_weight = denseWeight(fixed.images, moving.images);
+    }
+  }
+  return direct;
+}
+
+// Final figures on the full cloud at the finest length-scale: the last level's kernel at its
+// last iterate, a step short of T (a step under eps when converged; one more kernel pass at T
+// gave the same trajectories on teddy200).
+void setFinalFigures(const LevelKernel& kernel, std::size_t moving_points, SolverResult& result) {
+  const LevelSums& s = kernel.last();
+  result.nnz = std::size_t(s.nnz);
+  result.matched_fraction = double(s.matched) / double(std::max<std::size_t>(moving_points, 1));
+  result.objective = s.F;
+  // result.hessian: the information of the last iterate's quadratic (the Gauss-Newton matrix
+  // the steps solve with); the exact curvature of the narrow kernel is no better conditioned.
+  result.list_builds = kernel.listBuilds();
+}
+
 }  // namespace
 
 double planeFadeNoise(const CoarseToFineParams& p) { return p.depth_led ? 0.0 : p.depth_noise; }
@@ -216,13 +243,7 @@ SolverResult alignCoarseToFine(const CoarseToFineCloud& fixed, const CoarseToFin
     // A level need not resolve the motion finer than its length-scale allows: the next level
     // refines it (measured: a third fewer iterations, the same accuracy).
     const double eps = p.level_eps * ell / ells.back();
-    LevelDirect direct;
-    if (last && directTerms(p) && fixed.images.isReference() && !moving.images.empty()) {
-      direct = {&fixed.images, &moving.images, &moving.cloud, &fixed.cloud};
-      if (p.dense_point_to_plane) {
-        result.coarse_to_fine->dense_weight = denseWeight(fixed.images, moving.images);
-      }
-    }
+    const LevelDirect direct = levelDirect(fixed, moving, p, last, result);
     if (!iterateLevel(*kernel, direct, ell, eps, last, p, T, result)) {
       result.status = SolverStatus::kNotFinite;
       result.transform = guess;
@@ -235,16 +256,7 @@ SolverResult alignCoarseToFine(const CoarseToFineCloud& fixed, const CoarseToFin
     result.status = SolverStatus::kNotFinite;
     result.transform = guess;
   }
-  // Final figures on the full cloud at the finest length-scale: the last level's kernel at its
-  // last iterate, a step short of T (a step under eps when converged; one more kernel pass at T
-  // gave the same trajectories on teddy200).
-  const LevelSums& s = kernel->last();
-  result.nnz = std::size_t(s.nnz);
-  result.matched_fraction = double(s.matched) / double(std::max<std::size_t>(moving.size(), 1));
-  result.objective = s.F;
-  // result.hessian: the information of the last iterate's quadratic (the Gauss-Newton matrix
-  // the steps solve with); the exact curvature of the narrow kernel is no better conditioned.
-  result.list_builds = kernel->listBuilds();
+  setFinalFigures(*kernel, moving.size(), result);
   result.ms_total = msSince(t_start);
   return result;
 }

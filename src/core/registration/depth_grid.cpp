@@ -2,6 +2,7 @@
 // depth on a grid of pixels, and how much of the depth's noise they average away.
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <vector>
 
 #include "direct_helpers.hpp"
@@ -12,14 +13,21 @@ using direct::planeFade;
 using direct::sameSurface;
 using direct::smoothAround;
 
-DepthGrid denseGrid(const cv::Mat& depth, const Camera& camera, double depth_noise,
-                    int exact_grid_stride) {
-  DepthGrid grid;
-  const cv::Mat& D = depth;
-  constexpr int w = kGridWindow, quarter = w * w;
-  auto inside = [&D](int u, int v) { return u >= w && v >= w && u + w < D.cols && v + w < D.rows; };
-  // The squared twists of the windows that are one surface whole, in units of z^2.
+namespace {
+
+constexpr int w = kGridWindow;       // a window's half size
+constexpr int quarter = w * w;  // pixels in a quarter of a window
+
+// The squared twists of the windows that are one surface whole, in units of z^2: t of single
+// pixels, T of the four quarter means (DepthGrid), on every kGridStride-th pixel.
+struct Twists {
   std::vector<double> t2, T2;
+};
+Twists twistsOf(const cv::Mat& D) {
+  auto inside = [&D](int u, int v) { return u >= w && v >= w && u + w < D.cols && v + w < D.rows; };
+  Twists out;
+  std::vector<double>& t2 = out.t2;
+  std::vector<double>& T2 = out.T2;
   for (int v = kGridStride / 2; v < D.rows; v += kGridStride) {
     for (int u = kGridStride / 2; u < D.cols; u += kGridStride) {
       const float z = inside(u, v) ? D.at<float>(v, u) : 0.0f;
@@ -46,29 +54,24 @@ DepthGrid denseGrid(const cv::Mat& depth, const Camera& camera, double depth_noi
       T2.push_back(T * T * inv_z4);
     }
   }
-  if (T2.empty()) return grid;
-  // Means of the smallest 80%, not of all: a window across a fold (two walls' corner) twists by
-  // its shape. For Gaussian noise that is 0.438 of the variance, for t as for T.
-  auto trimmedMean = [](std::vector<double>& x) {
-    const auto cut = x.begin() + std::ptrdiff_t(std::max<std::size_t>(1, x.size() * 4 / 5));
-    std::nth_element(x.begin(), cut - 1, x.end());
-    double sum = 0.0;
-    for (auto it = x.begin(); it != cut; ++it) sum += *it;
-    return sum / double(cut - x.begin());
-  };
-  const double mt = trimmedMean(t2), mT = trimmedMean(T2);
-  // var(T) = 4 sigma^2 / 9 for noise per pixel: sigma as the windows see it.
-  grid.shared_noise = std::sqrt(double(quarter) * mT / 0.438 / 4.0);
-  grid.independence = mT > 0.0 ? std::min(1.0, mt / (double(quarter) * mT)) : 0.0;
-  const double exact = planeFade(grid.shared_noise, depth_noise);
-  grid.weight = std::max(grid.independence >= kMinIndependence ? grid.independence : 0.0, exact);
-  if (!(grid.weight > 0.0)) return grid;
-  // The twists above read every kGridStride-th pixel whatever the depth; the points are denser
-  // where it is exact.
-  grid.stride = grid.shared_noise < kExactDepthNoise * depth_noise ? exact_grid_stride : kGridStride;
-  const int stride = grid.stride;
-  // The window means, over the pixels of the centre's surface.
-  grid.points.reserve(std::size_t(D.rows / stride + 1) * std::size_t(D.cols / stride + 1));
+  return out;
+}
+
+// The mean of the smallest 80%, not of all: a window across a fold (two walls' corner) twists by
+// its shape. For Gaussian noise that is 0.438 of the variance, for t as for T. Reorders x.
+double trimmedMean(std::vector<double>& x) {
+  const auto cut = x.begin() + std::ptrdiff_t(std::max<std::size_t>(1, x.size() * 4 / 5));
+  std::nth_element(x.begin(), cut - 1, x.end());
+  double sum = 0.0;
+  for (auto it = x.begin(); it != cut; ++it) sum += *it;
+  return sum / double(cut - x.begin());
+}
+
+// The window means on every stride-th pixel, over the pixels of the centre's surface (at least
+// half the window).
+void addWindowMeans(const cv::Mat& D, const Camera& camera, int stride,
+                    std::vector<Eigen::Vector3d>& points) {
+  points.reserve(std::size_t(D.rows / stride + 1) * std::size_t(D.cols / stride + 1));
   for (int v = stride / 2; v < D.rows; v += stride) {
     for (int u = stride / 2; u < D.cols; u += stride) {
       const float z = D.at<float>(v, u);
@@ -90,10 +93,30 @@ DepthGrid denseGrid(const cv::Mat& depth, const Camera& camera, double depth_noi
         sz += row_z;
       }
       if (2 * n < (2 * w + 1) * (2 * w + 1)) continue;
-      grid.points.emplace_back((uz - camera.cx * sz) / (camera.fx * n),
-                               (vz - camera.cy * sz) / (camera.fy * n), sz / n);
+      points.emplace_back((uz - camera.cx * sz) / (camera.fx * n),
+                          (vz - camera.cy * sz) / (camera.fy * n), sz / n);
     }
   }
+}
+
+}  // namespace
+
+DepthGrid denseGrid(const cv::Mat& depth, const Camera& camera, double depth_noise,
+                    int exact_grid_stride) {
+  DepthGrid grid;
+  Twists twists = twistsOf(depth);
+  if (twists.T2.empty()) return grid;
+  const double mt = trimmedMean(twists.t2), mT = trimmedMean(twists.T2);
+  // var(T) = 4 sigma^2 / 9 for noise per pixel: sigma as the windows see it.
+  grid.shared_noise = std::sqrt(double(quarter) * mT / 0.438 / 4.0);
+  grid.independence = mT > 0.0 ? std::min(1.0, mt / (double(quarter) * mT)) : 0.0;
+  const double exact = planeFade(grid.shared_noise, depth_noise);
+  grid.weight = std::max(grid.independence >= kMinIndependence ? grid.independence : 0.0, exact);
+  if (!(grid.weight > 0.0)) return grid;
+  // The twists above read every kGridStride-th pixel whatever the depth; the points are denser
+  // where it is exact.
+  grid.stride = grid.shared_noise < kExactDepthNoise * depth_noise ? exact_grid_stride : kGridStride;
+  addWindowMeans(depth, camera, grid.stride, grid.points);
   return grid;
 }
 

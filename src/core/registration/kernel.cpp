@@ -42,25 +42,55 @@ double spatialRadius2(double ell, double sigma, double threshold) {
   return -2.0 * ell * ell * std::log(threshold / s2);
 }
 
-VoxelGrid::VoxelGrid(const std::vector<Eigen::Vector3f>& points, float cell) : cell_(cell) {
-  if (points.empty() || !(cell > 0.0f)) return;
-  // A non-finite point (from absurd intrinsics) has no place in the grid and no neighbours: it is
-  // left out, and the box spans the finite points only.
+namespace {
+
+// The box of the finite points' x and y, and how many they are (none: count 0). A non-finite
+// point (from absurd intrinsics) has no place in the grid and no neighbours.
+struct FiniteBox {
+  Eigen::Vector2f lo = Eigen::Vector2f::Zero(), hi = Eigen::Vector2f::Zero();
+  std::size_t count = 0;
+};
+FiniteBox finiteBox(const std::vector<Eigen::Vector3f>& points) {
   auto finite = [](const Eigen::Vector3f& p) { return p.allFinite(); };
+  FiniteBox box;
   const auto first = std::find_if(points.begin(), points.end(), finite);
-  if (first == points.end()) return;
-  Eigen::Vector2f lo = first->head<2>(), hi = first->head<2>();
-  std::size_t finite_points = 0;
+  if (first == points.end()) return box;
+  box.lo = first->head<2>(), box.hi = first->head<2>();
   for (const auto& p : points) {
     if (!finite(p)) continue;
-    lo = lo.cwiseMin(p.head<2>());
-    hi = hi.cwiseMax(p.head<2>());
-    ++finite_points;
+    box.lo = box.lo.cwiseMin(p.head<2>());
+    box.hi = box.hi.cwiseMax(p.head<2>());
+    ++box.count;
   }
+  return box;
+}
+
+// Each column's run of `order` (the point indices, by column) sorted by depth.
+void sortColumnsByDepth(const std::vector<Eigen::Vector3f>& points,
+                        const std::vector<int>& column_start, std::vector<int>& order) {
+  for (std::size_t c = 0; c + 1 < column_start.size(); ++c) {
+    const auto begin = order.begin() + column_start[c];
+    const auto end = order.begin() + column_start[c + 1];
+    if (end - begin > 1) {
+      std::sort(begin, end, [&](int a, int b) {
+        return points[std::size_t(a)].z() < points[std::size_t(b)].z();
+      });
+    }
+  }
+}
+
+}  // namespace
+
+VoxelGrid::VoxelGrid(const std::vector<Eigen::Vector3f>& points, float cell) : cell_(cell) {
+  if (points.empty() || !(cell > 0.0f)) return;
+  // Non-finite points are left out, and the box spans the finite points only.
+  const FiniteBox box = finiteBox(points);
+  if (box.count == 0) return;
+  const Eigen::Vector2f lo = box.lo, hi = box.hi;
   // A cloud spread far beyond the radius would make a huge grid of empty columns: coarsen the
   // cells then (candidates stay a superset of the true neighbours, searches only get slower).
   // The extent is taken in double: hi - lo of finite floats may overflow float.
-  const double max_columns = maxColumns(finite_points);
+  const double max_columns = maxColumns(box.count);
   const Eigen::Vector2d extent = hi.cast<double>() - lo.cast<double>();
   for (;;) {
     const Eigen::Vector2d n = (extent / double(cell_)).array().floor() + 1.0;
@@ -76,7 +106,7 @@ VoxelGrid::VoxelGrid(const std::vector<Eigen::Vector3f>& points, float cell) : c
   std::vector<int> column_of(points.size(), -1);
   column_start_.assign(std::size_t(columns) + 1, 0);
   for (std::size_t i = 0; i < points.size(); ++i) {
-    if (!finite(points[i])) continue;
+    if (!points[i].allFinite()) continue;
     // Clamped before the conversion to int: p - origin may overflow float to +inf.
     const Eigen::Vector2f r = ((points[i].head<2>() - origin_) / cell_).cwiseMin(top);
     column_of[i] = int(r.y()) * nx_ + int(r.x());
@@ -88,18 +118,10 @@ VoxelGrid::VoxelGrid(const std::vector<Eigen::Vector3f>& points, float cell) : c
   for (std::size_t i = 0; i < points.size(); ++i) {
     if (column_of[i] >= 0) order_[std::size_t(fill[std::size_t(column_of[i])]++)] = int(i);
   }
+  sortColumnsByDepth(points, column_start_, order_);
   x_.resize(order_.size());
   y_.resize(order_.size());
   z_.resize(order_.size());
-  for (int c = 0; c < columns; ++c) {
-    const auto begin = order_.begin() + column_start_[std::size_t(c)];
-    const auto end = order_.begin() + column_start_[std::size_t(c) + 1];
-    if (end - begin > 1) {
-      std::sort(begin, end, [&](int a, int b) {
-        return points[std::size_t(a)].z() < points[std::size_t(b)].z();
-      });
-    }
-  }
   for (std::size_t k = 0; k < order_.size(); ++k) {
     const Eigen::Vector3f& p = points[std::size_t(order_[k])];
     x_[k] = p.x();
@@ -194,6 +216,70 @@ void runDistances(std::size_t len, const float* __restrict px, const float* __re
   }
 }
 
+// sigma^2 colorFactor >= sparsification as a bound on the label distance: most pairs in reach
+// fail on colour, and the bound spares them the exponential (-1: no pair can pass).
+float labelDistanceBound(const KernelConstants& k) {
+  const float ratio = k.sigma2 * k.color_sigma2 / k.sparsification;
+  return !(ratio >= 1.0f) ? -1.0f : (k.color_inv > 0.0f ? std::log(ratio) / k.color_inv : INFINITY);
+}
+
+// Room in the chunk's work buffers for a run of len grid points after `within` near ones.
+inline void reserveRun(CandidateLists::Chunk& chunk, std::size_t within, std::size_t len) {
+  if (chunk.run_d2.size() < len) {
+    chunk.run_d2.resize(2 * len);
+    chunk.run_label_d2.resize(2 * len);
+  }
+  if (chunk.near.size() < within + len) {
+    chunk.near.resize(2 * (within + len));
+    chunk.near_label_d2.resize(2 * (within + len));
+  }
+}
+
+// The chunk's `within` near grid points (chunk.near) appended to its lists after the `kept`
+// pairs so far, each with its label distance in place of its colour factor (finishChunk's).
+inline void appendNear(CandidateLists::Chunk& chunk, std::size_t within, const VoxelGrid& grid,
+                       std::size_t& kept) {
+  const std::size_t most = kept + within;
+  if (chunk.i.size() < most) {
+    chunk.i.resize(most);
+    chunk.color.resize(most);
+    chunk.x.resize(most);
+    chunk.y.resize(most);
+    chunk.z.resize(most);
+  }
+  const float* gx = grid.xs();
+  const float* gy = grid.ys();
+  const float* gzs = grid.zs();
+  for (std::size_t w = 0; w < within; ++w) {
+    const int k = chunk.near[w];
+    chunk.i[kept] = grid.index(k);
+    chunk.color[kept] = chunk.near_label_d2[w];  // its colour factor below, for the chunk
+    chunk.x[kept] = gx[k];
+    chunk.y[kept] = gy[k];
+    chunk.z[kept] = gzs[k];
+    ++kept;
+  }
+}
+
+// The chunk's lists cut to its `kept` pairs, their colour factors from their label distances,
+// and its scratch buffers as long as its `longest` list.
+void finishChunk(CandidateLists::Chunk& chunk, std::size_t kept, int longest,
+                 const KernelConstants& k) {
+  chunk.i.resize(kept);
+  chunk.color.resize(kept);
+  chunk.x.resize(kept);
+  chunk.y.resize(kept);
+  chunk.z.resize(kept);
+  // The colour factors of the chunk's pairs from their label distances, vectorised (one
+  // std::exp per pair took 2-3% of a frame).
+  Eigen::Map<Eigen::ArrayXf> color(chunk.color.data(), Eigen::Index(chunk.color.size()));
+  color = k.color_sigma2 * (color * -k.color_inv).exp();
+  if (chunk.scratch_d2.size() < longest) {
+    chunk.scratch_d2.resize(longest);
+    chunk.scratch_a.resize(longest);
+  }
+}
+
 }  // namespace
 
 void CandidateLists::build(const Eigen::Isometry3d& T, float radius) {
@@ -202,11 +288,7 @@ void CandidateLists::build(const Eigen::Isometry3d& T, float radius) {
   const auto& Z = moving_.points;
   const auto& gz = moving_.labels;
   const int n = int(Z.size());
-  // sigma^2 colorFactor >= sparsification as a bound on the label distance: most pairs in reach
-  // fail on colour, and the bound spares them the exponential.
-  const float ratio = k_.sigma2 * k_.color_sigma2 / k_.sparsification;
-  const float label_d2_max =
-      !(ratio >= 1.0f) ? -1.0f : (k_.color_inv > 0.0f ? std::log(ratio) / k_.color_inv : INFINITY);
+  const float label_d2_max = labelDistanceBound(k_);
   // Both tests run over a column's run of grid points at once, vectorised: three in four points
   // of a run fail the first and about half the rest the second. A pair is then kept by adding
   // the tests' outcome to the count instead of branching on it, in no order a branch predictor
@@ -230,14 +312,7 @@ void CandidateLists::build(const Eigen::Isometry3d& T, float radius) {
       std::size_t within = 0;  // of chunk.near and chunk.near_label_d2
       grid_.forEachRun(y, rj, [&](int begin, int stop) {
         const std::size_t len = std::size_t(stop - begin);
-        if (chunk.run_d2.size() < len) {
-          chunk.run_d2.resize(2 * len);
-          chunk.run_label_d2.resize(2 * len);
-        }
-        if (chunk.near.size() < within + len) {
-          chunk.near.resize(2 * (within + len));
-          chunk.near_label_d2.resize(2 * (within + len));
-        }
+        reserveRun(chunk, within, len);
         float* d2 = chunk.run_d2.data();
         float* label_d2 = chunk.run_label_d2.data();
         runDistances(len, gx + begin, gy + begin, gzs + begin, y, gl, begin, g, d2, label_d2);
@@ -249,40 +324,12 @@ void CandidateLists::build(const Eigen::Isometry3d& T, float radius) {
           within += std::size_t((d2[q] < radius2) & (label_d2[q] <= label_d2_max));
         }
       });
-      const std::size_t most = kept + within;
-      if (chunk.i.size() < most) {
-        chunk.i.resize(most);
-        chunk.color.resize(most);
-        chunk.x.resize(most);
-        chunk.y.resize(most);
-        chunk.z.resize(most);
-      }
-      for (std::size_t w = 0; w < within; ++w) {
-        const int k = chunk.near[w];
-        chunk.i[kept] = grid_.index(k);
-        chunk.color[kept] = chunk.near_label_d2[w];  // its colour factor below, for the chunk
-        chunk.x[kept] = gx[k];
-        chunk.y[kept] = gy[k];
-        chunk.z[kept] = gzs[k];
-        ++kept;
-      }
+      appendNear(chunk, within, grid_, kept);
       chunk.end.push_back(int(kept));
       longest = std::max(longest, chunk.end.back() - start);
       start = chunk.end.back();
     }
-    chunk.i.resize(kept);
-    chunk.color.resize(kept);
-    chunk.x.resize(kept);
-    chunk.y.resize(kept);
-    chunk.z.resize(kept);
-    // The colour factors of the chunk's pairs from their label distances, vectorised (one
-    // std::exp per pair took 2-3% of a frame).
-    Eigen::Map<Eigen::ArrayXf> color(chunk.color.data(), Eigen::Index(chunk.color.size()));
-    color = k_.color_sigma2 * (color * -k_.color_inv).exp();
-    if (chunk.scratch_d2.size() < longest) {
-      chunk.scratch_d2.resize(longest);
-      chunk.scratch_a.resize(longest);
-    }
+    finishChunk(chunk, kept, longest, k_);
   });
   T_ = T;
   radius_ = radius;

@@ -54,6 +54,64 @@ PairSums keptPairSums(int m, const float* d2, float* a, const float* x, const fl
   return p;
 }
 
+// The m > 0 candidates of one moving point placed at y (from the k-th of its chunk's lists), with
+// its ray, depth-noise share kappa, 1 / (2 ell_j^2) `inv` and squared radius r2: their squared
+// distances and kernel values, computed for all of them at once, then the sums of those that
+// count.
+inline PairSums candidateSums(CandidateLists::Chunk& chunk, int k, int m, const Eigen::Vector3f& y,
+                              const Eigen::Vector3f& ray, float kappa, float sigma2, float inv,
+                              float r2, float sp) {
+  using Map = Eigen::Map<const Eigen::ArrayXf>;
+  auto d2 = chunk.scratch_d2.head(m);
+  auto a = chunk.scratch_a.head(m);
+  const Map cx(chunk.x.data() + k, m), cy(chunk.y.data() + k, m), cz(chunk.z.data() + k, m);
+  d2 = (cx - y.x()).square() + (cy - y.y()).square() + (cz - y.z()).square();
+  if (kappa > 0.0f) {
+    const auto along = (cx - y.x()) * ray.x() + (cy - y.y()) * ray.y() + (cz - y.z()) * ray.z();
+    a = sigma2 * ((d2 - kappa * along.square()) * -inv).exp() * Map(chunk.color.data() + k, m);
+  } else {
+    a = sigma2 * (d2 * -inv).exp() * Map(chunk.color.data() + k, m);
+  }
+  return keptPairSums(m, d2.data(), a.data(), cx.data(), cy.data(), cz.data(), r2, sp);
+}
+
+// A chunk's H from moments of its matched points: sum w a, sum w a y, sum w a y y^T and
+// sum w a kappa ray ray^T.
+struct Moments {
+  double m0 = 0.0;
+  Eigen::Vector3d m1 = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d m2 = Eigen::Matrix3d::Zero(), along = Eigen::Matrix3d::Zero();
+};
+
+// A matched point's share (its pairs' sums x_sum, a_sum > 0; s2 its squared length-scale
+// factor): its pairs weigh (x_i - y)^T W (x_i - y) by a_ij / ell_j^2, W = I - kappa ray ray^T;
+// they share y, so they enter through sum a and sum a x. With J = [-hat(y), I] and ray along y
+// (so J^T ray = [0; ray]): J^T W J = [[|y|^2 I - y y^T, hat(y)], [hat(y)^T, I - kappa ray
+// ray^T]], summed as moments; J^T W e = [y x W e; W e].
+inline void addMatched(LevelSums& s, Moments& mo, const Eigen::Vector3f& y,
+                       const Eigen::Vector3f& ray, const Eigen::Vector3f& x_sum, float a_sum,
+                       float s2, float kappa) {
+  ++s.matched;
+  const double wa = double(a_sum) / double(s2);
+  const Eigen::Vector3d yd = y.cast<double>(), rd = ray.cast<double>();
+  mo.m0 += wa;
+  mo.m1 += wa * yd;
+  mo.m2.noalias() += (wa * yd) * yd.transpose();
+  mo.along.noalias() += (wa * double(kappa) * rd) * rd.transpose();
+  const Eigen::Vector3d e = (x_sum.cast<double>() - double(a_sum) * yd) / double(s2);
+  const Eigen::Vector3d we = e - double(kappa) * rd * rd.dot(e);
+  s.g.head<3>() += yd.cross(we);
+  s.g.tail<3>() += we;
+}
+
+// J^T W J summed over a chunk's matched points, from their moments.
+void setH(LevelSums& s, const Moments& mo) {
+  s.H.topLeftCorner<3, 3>() = mo.m2.trace() * Eigen::Matrix3d::Identity() - mo.m2;
+  s.H.topRightCorner<3, 3>() = hat(mo.m1);
+  s.H.bottomLeftCorner<3, 3>() = hat(mo.m1).transpose();
+  s.H.bottomRightCorner<3, 3>() = mo.m0 * Eigen::Matrix3d::Identity() - mo.along;
+}
+
 }  // namespace
 
 bool perPointKernel(const CoarseToFineParams& p) {
@@ -106,11 +164,7 @@ const LevelSums& LevelKernel::evaluate(const Eigen::Isometry3d& T, double ell) {
     CandidateLists::Chunk& chunk = lists_.chunk(c);
     // Per-chunk accumulation in double; one point's few terms are summed in float.
     LevelSums s;
-    // This chunk's H from moments of the matched points (see below): sum w a, sum w a y,
-    // sum w a y y^T and sum w a kappa ray ray^T.
-    double m0 = 0.0;
-    Eigen::Vector3d m1 = Eigen::Vector3d::Zero();
-    Eigen::Matrix3d m2 = Eigen::Matrix3d::Zero(), along = Eigen::Matrix3d::Zero();
+    Moments mo;
     int k = 0;
     const int end = std::min(n, (c + 1) * kChunk);
     for (int j = c * kChunk; j < end; ++j) {
@@ -120,54 +174,18 @@ const LevelSums& LevelKernel::evaluate(const Eigen::Isometry3d& T, double ell) {
       const float r2 = r2_unit * search * search, inv = inv_unit / s2;
       const float kappa = kappa_[std::size_t(j)];
       const Eigen::Vector3f ray = y.normalized();
-      Eigen::Vector3f x_sum = Eigen::Vector3f::Zero();
-      float a_sum = 0.0f;
       const int k_end = chunk.end[std::size_t(j - c * kChunk)];
       const int m = k_end - k;
+      PairSums p;
       if (m > 0) {
-        // Vectorised: squared distances and kernel values of all candidates of this point.
-        using Map = Eigen::Map<const Eigen::ArrayXf>;
-        auto d2 = chunk.scratch_d2.head(m);
-        auto a = chunk.scratch_a.head(m);
-        const Map cx(chunk.x.data() + k, m), cy(chunk.y.data() + k, m), cz(chunk.z.data() + k, m);
-        d2 = (cx - y.x()).square() + (cy - y.y()).square() + (cz - y.z()).square();
-        if (kappa > 0.0f) {
-          const auto along = (cx - y.x()) * ray.x() + (cy - y.y()) * ray.y() + (cz - y.z()) * ray.z();
-          a = sigma2 * ((d2 - kappa * along.square()) * -inv).exp() * Map(chunk.color.data() + k, m);
-        } else {
-          a = sigma2 * (d2 * -inv).exp() * Map(chunk.color.data() + k, m);
-        }
-        const PairSums p = keptPairSums(m, d2.data(), a.data(), cx.data(), cy.data(), cz.data(),
-                                        r2, sp);
-        x_sum = p.x;
-        a_sum = p.a;
+        p = candidateSums(chunk, k, m, y, ray, kappa, sigma2, inv, r2, sp);
         s.nnz += p.kept;
       }
       k = k_end;
-      if (a_sum > 0.0f) {
-        ++s.matched;
-        // This point's pairs weigh (x_i - y)^T W (x_i - y) by a_ij / ell_j^2,
-        // W = I - kappa ray ray^T; they share y, so they enter through sum a and sum a x.
-        // With J = [-hat(y), I] and ray along y (so J^T ray = [0; ray]):
-        // J^T W J = [[|y|^2 I - y y^T, hat(y)], [hat(y)^T, I - kappa ray ray^T]], summed as
-        // moments; J^T W e = [y x W e; W e].
-        const double wa = double(a_sum) / double(s2);
-        const Eigen::Vector3d yd = y.cast<double>(), rd = ray.cast<double>();
-        m0 += wa;
-        m1 += wa * yd;
-        m2.noalias() += (wa * yd) * yd.transpose();
-        along.noalias() += (wa * double(kappa) * rd) * rd.transpose();
-        const Eigen::Vector3d e = (x_sum.cast<double>() - double(a_sum) * yd) / double(s2);
-        const Eigen::Vector3d we = e - double(kappa) * rd * rd.dot(e);
-        s.g.head<3>() += yd.cross(we);
-        s.g.tail<3>() += we;
-      }
-      s.F += a_sum;
+      if (p.a > 0.0f) addMatched(s, mo, y, ray, p.x, p.a, s2, kappa);
+      s.F += p.a;
     }
-    s.H.topLeftCorner<3, 3>() = m2.trace() * Eigen::Matrix3d::Identity() - m2;
-    s.H.topRightCorner<3, 3>() = hat(m1);
-    s.H.bottomLeftCorner<3, 3>() = hat(m1).transpose();
-    s.H.bottomRightCorner<3, 3>() = m0 * Eigen::Matrix3d::Identity() - along;
+    setH(s, mo);
     partial_[std::size_t(c)] = s;
   });
 

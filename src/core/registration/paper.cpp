@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "acvo/odometry/covariance.hpp"
 #include "acvo/timing.hpp"
@@ -51,6 +52,35 @@ void finish(PaperKernel& kernel, const PaperCloud& fixed, const PaperCloud& movi
     result.status = SolverStatus::kNotFinite;
     result.transform = guess.matrix().allFinite() ? guess : Eigen::Isometry3d::Identity();
   }
+}
+
+// The length-scale of iteration `it`: the adaptive one, or the schedule's (its first step at
+// the length-scale carried over from the last registration, where there is one).
+double usedEll(const PaperParams& p, const LengthScale& ls, double carried_ell, int it) {
+  const bool adaptive = p.ell_policy == EllPolicy::kAdaptive;
+  return adaptive ? ls.ell
+         : carried_ell > 0.0 && scheduledEll(it) == scheduledEll(0) ? carried_ell
+                                                                     : scheduledEll(it);
+}
+
+// Where the gradient ends the iteration: not finite, or under eps_gradient (converged).
+std::optional<SolverStatus> gradientStop(const CrossSums& s, const PaperParams& p) {
+  if (!s.omega.allFinite() || !s.v.allFinite()) return SolverStatus::kNotFinite;
+  if (s.omega.norm() < p.eps_gradient && s.v.norm() < p.eps_gradient) {
+    return SolverStatus::kConverged;
+  }
+  return std::nullopt;
+}
+
+// The step length along the gradient xi (solveStep on the kernel's step sums there), its time
+// added to the figures' ms_step.
+double stepLength(const PaperKernel& kernel, const Vector6d& xi, const PaperParams& p,
+                  SolverResult& result) {
+  const auto t0 = Clock::now();
+  const StepSums st = kernel.stepSums(xi.head<3>(), xi.tail<3>());
+  const double step = solveStep(st.B, st.C, st.D, st.E, p.min_step, p.max_step);
+  result.paper->ms_step += msSince(t0);
+  return step;
 }
 
 }  // namespace
@@ -112,27 +142,17 @@ SolverResult alignPaper(const PaperCloud& fixed, const PaperCloud& moving,
   result.status = SolverStatus::kMaxIterations;
   int it = 0;
   for (; it < p.max_iterations; ++it) {
-    const double used_ell = adaptive ? ls.ell
-                            : carried_ell > 0.0 && scheduledEll(it) == scheduledEll(0)
-                                ? carried_ell
-                                : scheduledEll(it);
+    const double used_ell = usedEll(p, ls, carried_ell, it);
     auto t0 = Clock::now();
     const CrossSums& s = kernel.evaluate(T, used_ell);
     result.ms_neighbours += msSince(t0);
-    if (!s.omega.allFinite() || !s.v.allFinite()) {
-      result.status = SolverStatus::kNotFinite;
-      break;
-    }
-    if (s.omega.norm() < p.eps_gradient && s.v.norm() < p.eps_gradient) {
-      result.status = SolverStatus::kConverged;
+    if (const auto stop = gradientStop(s, p)) {
+      result.status = *stop;
       break;
     }
     Vector6d xi;
     xi << s.omega, s.v;
-    t0 = Clock::now();
-    const StepSums st = kernel.stepSums(xi.head<3>(), xi.tail<3>());
-    const double step = solveStep(st.B, st.C, st.D, st.E, p.min_step, p.max_step);
-    result.paper->ms_step += msSince(t0);
+    const double step = stepLength(kernel, xi, p, result);
     const Eigen::Isometry3d dT = expSE3(-step * xi);
     if (!dT.matrix().allFinite()) {
       result.status = SolverStatus::kNotFinite;

@@ -3,10 +3,51 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <vector>
 
 #include "acvo/math/se3.hpp"
 
 namespace acvo {
+namespace {
+
+// The sums over one moving point's kept pairs: sum a x cross y, sum a (y - x), sum a, sum a d2.
+struct PointSums {
+  Eigen::Vector3f cross = Eigen::Vector3f::Zero(), diff = Eigen::Vector3f::Zero();
+  float a = 0.0f, ad2 = 0.0f;
+};
+
+// The m > 0 candidates of the moving point placed at y (from the k-th of its chunk's lists):
+// their squared distances and kernel values, computed for all of them at once; then those that
+// count (inside the radius, kernel value at least the sparsification threshold) appended to
+// `pairs` as (i, a) and summed. One point's few terms are summed in float.
+template <typename Pairs>
+inline PointSums keptPairs(CandidateLists::Chunk& cand, int k, int m, const Eigen::Vector3f& y,
+                           const std::vector<Eigen::Vector3f>& X, float sigma2, float inv,
+                           float r2, float sp, Pairs& pairs) {
+  PointSums s;
+  using Map = Eigen::Map<const Eigen::ArrayXf>;
+  auto d2 = cand.scratch_d2.head(m);
+  auto a = cand.scratch_a.head(m);
+  d2 = (Map(cand.x.data() + k, m) - y.x()).square() +
+       (Map(cand.y.data() + k, m) - y.y()).square() +
+       (Map(cand.z.data() + k, m) - y.z()).square();
+  a = sigma2 * (d2 * -inv).exp() * Map(cand.color.data() + k, m);
+  for (int q = 0; q < m; ++q) {
+    if (!(d2[q] < r2) || a[q] < sp) continue;
+    const int i = cand.i[std::size_t(k) + std::size_t(q)];
+    const float aq = a[q];
+    pairs.push_back({i, aq});
+    const Eigen::Vector3f& x = X[std::size_t(i)];
+    s.cross += aq * x.cross(y);
+    s.diff += aq * (y - x);
+    s.a += aq;
+    s.ad2 += aq * d2[q];
+  }
+  return s;
+}
+
+}  // namespace
 
 double largestEll(const PaperParams& p) {
   double ell = std::max(p.ell_init, p.ell_max);
@@ -84,45 +125,24 @@ const CrossSums& PaperKernel::evaluate(const Eigen::Isometry3d& T, double ell) {
     ChunkPairs& out = chunks_[std::size_t(c)];
     out.pairs.clear();
     out.end.clear();
-    // Per-chunk accumulation in double; one point's few terms are summed in float.
+    // Per-chunk accumulation in double; one point's few terms are summed in float (keptPairs).
     CrossSums s;
     int k = 0;
     const int end = std::min(n, (c + 1) * kChunk);
     for (int j = c * kChunk; j < end; ++j) {
       const Eigen::Vector3f y = R * Z[std::size_t(j)] + t;
       y_[std::size_t(j)] = y;
-      Eigen::Vector3f cross_sum = Eigen::Vector3f::Zero(), diff_sum = Eigen::Vector3f::Zero();
-      float a_sum = 0.0f, ad2_sum = 0.0f;
       const int k_end = cand.end[std::size_t(j - c * kChunk)];
       const int m = k_end - k;
-      if (m > 0) {
-        // Vectorised: squared distances and kernel values of all candidates of this point.
-        using Map = Eigen::Map<const Eigen::ArrayXf>;
-        auto d2 = cand.scratch_d2.head(m);
-        auto a = cand.scratch_a.head(m);
-        d2 = (Map(cand.x.data() + k, m) - y.x()).square() +
-             (Map(cand.y.data() + k, m) - y.y()).square() +
-             (Map(cand.z.data() + k, m) - y.z()).square();
-        a = sigma2 * (d2 * -inv).exp() * Map(cand.color.data() + k, m);
-        for (int q = 0; q < m; ++q) {
-          if (!(d2[q] < r2) || a[q] < sp) continue;
-          const int i = cand.i[std::size_t(k) + std::size_t(q)];
-          const float aq = a[q];
-          out.pairs.push_back({i, aq});
-          const Eigen::Vector3f& x = X[std::size_t(i)];
-          cross_sum += aq * x.cross(y);
-          diff_sum += aq * (y - x);
-          a_sum += aq;
-          ad2_sum += aq * d2[q];
-        }
-      }
+      PointSums p;
+      if (m > 0) p = keptPairs(cand, k, m, y, X, sigma2, inv, r2, sp, out.pairs);
       k = k_end;
-      if (a_sum > 0.0f) ++s.matched;
+      if (p.a > 0.0f) ++s.matched;
       out.end.push_back(int(out.pairs.size()));
-      s.omega += cross_sum.cast<double>();
-      s.v += diff_sum.cast<double>();
-      s.F += a_sum;
-      s.F_d2 += ad2_sum;
+      s.omega += p.cross.cast<double>();
+      s.v += p.diff.cast<double>();
+      s.F += p.a;
+      s.F_d2 += p.ad2;
     }
     s.nnz = std::int64_t(out.pairs.size());
     out.sums = s;

@@ -78,7 +78,30 @@ Eigen::Vector3d windowMean(const cv::Mat& sums, int u, int v, double& count) {
   return Eigen::Vector3d(double(s[0]), double(s[1]), double(s[2])) / count;
 }
 
+// Where a point of the moving depth grid lands in the reference: y there, and its pixel.
+struct GridLanding {
+  Eigen::Vector3d y;
+  int u, v;
+};
+// The grid's points placed by T that land in front of the camera and `margin` pixels inside the
+// reference's depth D, in the grid's order.
+std::vector<GridLanding> gridLandings(const DepthGrid& grid, const Eigen::Isometry3d& T,
+                                      const Camera& cam, const cv::Mat& D, int margin) {
+  std::vector<GridLanding> landed;
+  landed.reserve(grid.points.size());
+  for (const Eigen::Vector3d& p : grid.points) {
+    const Eigen::Vector3d y = T * p;
+    if (!(y.z() > 0.0)) continue;
+    const int u = int(std::lround(cam.fx * y.x() / y.z() + cam.cx));
+    const int v = int(std::lround(cam.fy * y.y() / y.z() + cam.cy));
+    if (u < margin || v < margin || u + margin >= D.cols || v + margin >= D.rows) continue;
+    landed.push_back({y, u, v});
+  }
+  return landed;
+}
+
 }  // namespace
+
 double denseWeight(const DirectImages& reference, const DirectImages& moving_images) {
   const bool both = !reference.point_sums.empty() && !moving_images.grid.empty();
   return both ? moving_images.grid.weight : 0.0;
@@ -96,20 +119,7 @@ DirectSums densePlaneSums(const DirectImages& reference, const DirectImages& mov
   constexpr double half = 0.5 * (2 * w + 1) * (2 * w + 1);
   // Where the grid's points land, then their planes, each with the pixels of the one kAhead on
   // asked for (the window sums are 16 bytes a pixel: 4.9 MB at 640x480).
-  struct GridLanding {
-    Eigen::Vector3d y;
-    int u, v;
-  };
-  std::vector<GridLanding> landed;
-  landed.reserve(grid.points.size());
-  for (const Eigen::Vector3d& p : grid.points) {
-    const Eigen::Vector3d y = T * p;
-    if (!(y.z() > 0.0)) continue;
-    const int u = int(std::lround(cam.fx * y.x() / y.z() + cam.cx));
-    const int v = int(std::lround(cam.fy * y.y() / y.z() + cam.cy));
-    if (u < margin || v < margin || u + margin >= D.cols || v + margin >= D.rows) continue;
-    landed.push_back({y, u, v});
-  }
+  const std::vector<GridLanding> landed = gridLandings(grid, T, cam, D, margin);
   std::vector<Residual> residuals;
   residuals.reserve(landed.size());
   for (std::size_t k = 0; k < landed.size(); ++k) {
