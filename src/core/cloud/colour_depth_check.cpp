@@ -2,7 +2,9 @@
 #include "acvo/cloud/colour_depth_check.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstddef>
 #include <cstdio>
 #include <vector>
 
@@ -25,6 +27,27 @@ float sample(const cv::Mat& image, double x, double y) {
   const float* r1 = image.ptr<float>(y0 + 1);
   return (1 - fy) * ((1 - fx) * r0[x0] + fx * r0[x0 + 1]) +
          fy * ((1 - fx) * r1[x0] + fx * r1[x0 + 1]);
+}
+
+using EdgePoint = ColourDepthCheck::EdgePoint;
+
+// The depth-edge pixels (u, v) with their depth.
+std::vector<EdgePoint> edgePoints(const std::vector<std::array<int, 2>>& pixels,
+                                  const cv::Mat& depth) {
+  std::vector<EdgePoint> edges;
+  edges.reserve(pixels.size());
+  for (const auto& [u, v] : pixels) edges.push_back({float(u), float(v), depth.at<float>(v, u)});
+  return edges;
+}
+
+// The grid's evidence: the edges thinned to every k-th (k = edges / max_edges, rounded down:
+// under twice that many, all).
+std::vector<EdgePoint> thinnedEdges(const std::vector<EdgePoint>& edges, int max_edges) {
+  const std::size_t step =
+      std::max<std::size_t>(1, edges.size() / std::size_t(std::max(1, max_edges)));
+  std::vector<EdgePoint> thinned;
+  for (std::size_t i = 0; i < edges.size(); i += step) thinned.push_back(edges[i]);
+  return thinned;
 }
 
 }  // namespace
@@ -119,20 +142,11 @@ const ColourDepthCheck::Verdict& ColourDepthCheck::add(const Frame& frame) {
   ++verdict_.frames_seen;
   const auto pixels = depthEdges(frame.depth, options_.depth_jump);
   if (int(pixels.size()) < options_.min_edge_pixels) return verdict_;
-  std::vector<EdgePoint> edges;
-  edges.reserve(pixels.size());
-  for (const auto& [u, v] : pixels) {
-    edges.push_back({float(u), float(v), frame.depth.at<float>(v, u)});
-  }
+  const std::vector<EdgePoint> edges = edgePoints(pixels, frame.depth);
   const cv::Mat strength = edgeStrength(grayImage(frame));
   const auto s = ratioScores(strength, frame.camera, edges);
   if (s[kRatios / 2] <= 0.0) return verdict_;  // no colour edges (a blank colour image)
-  // The grid's evidence: the edges thinned to every k-th (k = edges / max_edges_per_frame,
-  // rounded down: under twice that many, all).
-  const std::size_t step = std::max<std::size_t>(
-      1, edges.size() / std::size_t(std::max(1, options_.max_edges_per_frame)));
-  std::vector<EdgePoint> thinned;
-  for (std::size_t i = 0; i < edges.size(); i += step) thinned.push_back(edges[i]);
+  const std::vector<EdgePoint> thinned = thinnedEdges(edges, options_.max_edges_per_frame);
   // Every camera of the grid on those edges (41 x 13 cameras), in all and by the image's quarters
   // about the principal point. A quarter whose edges a camera does not see at all adds nothing
   // for it, which errs towards "registered".

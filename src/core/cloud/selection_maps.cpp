@@ -76,6 +76,39 @@ int countAtMost(const std::uint8_t* rows, int stride, int row_count, int u0, int
   return count;
 }
 
+// The bins of rows [v0, v1) of mag2 (into `bins`, row v at v - v0): each pixel's floor(|grad I|),
+// clamped to kHistMax, as a byte (the square root vectorised, through `root`).
+void binRows(const CandidateLevel& mag2, int v0, int v1, std::vector<float>& root,
+             std::vector<std::uint8_t>& bins) {
+  const int w = mag2.width;
+  for (int v = v0; v < v1; ++v) {
+    const float* row = &mag2.value[static_cast<std::size_t>(v) * w];
+    std::uint8_t* out = &bins[static_cast<std::size_t>(v - v0) * w];
+    for (int u = 1; u + 1 < w; ++u) root[std::size_t(u)] = std::sqrt(row[u]);
+    for (int u = 1; u + 1 < w; ++u) {
+      out[u] =
+          static_cast<std::uint8_t>(std::min(static_cast<int>(root[std::size_t(u)]), kHistMax));
+    }
+  }
+}
+
+// The median bin of the block of columns [u0, u1) of the `row_count` binned rows (stride w): the
+// first bin whose cumulative count exceeds half the block's pixels (kHistMax at most), by
+// bisection over [0, kHistMax].
+int medianBin(const std::vector<std::uint8_t>& bins, int w, int row_count, int u0, int u1) {
+  const int half = row_count * (u1 - u0) / 2;
+  int lo = 0, hi = kHistMax;
+  while (lo < hi) {
+    const int mid = (lo + hi) / 2;
+    if (countAtMost(bins.data(), w, row_count, u0, u1, std::uint8_t(mid)) > half) {
+      hi = mid;
+    } else {
+      lo = mid + 1;
+    }
+  }
+  return lo;
+}
+
 BlockThresholds blockThresholds(const CandidateLevel& mag2) {
   const int w = mag2.width, h = mag2.height;
   const int bx = (w + kBlock - 1) / kBlock, by = (h + kBlock - 1) / kBlock;
@@ -90,29 +123,11 @@ BlockThresholds blockThresholds(const CandidateLevel& mag2) {
   for (int b = 0; b < by; ++b) {
     const int v0 = std::max(b * kBlock, 1), v1 = std::min((b + 1) * kBlock, h - 1);
     if (v0 >= v1) continue;
-    for (int v = v0; v < v1; ++v) {
-      const float* row = &mag2.value[static_cast<std::size_t>(v) * w];
-      std::uint8_t* out = &bins[static_cast<std::size_t>(v - v0) * w];
-      for (int u = 1; u + 1 < w; ++u) root[std::size_t(u)] = std::sqrt(row[u]);
-      for (int u = 1; u + 1 < w; ++u) {
-        out[u] =
-            static_cast<std::uint8_t>(std::min(static_cast<int>(root[std::size_t(u)]), kHistMax));
-      }
-    }
+    binRows(mag2, v0, v1, root, bins);
     for (int a = 0; a < bx; ++a) {
       const int u0 = std::max(a * kBlock, 1), u1 = std::min((a + 1) * kBlock, w - 1);
       if (u0 >= u1) continue;
-      const int half = (v1 - v0) * (u1 - u0) / 2;
-      // The first bin whose cumulative count exceeds half the block's pixels (kHistMax at most).
-      int lo = 0, hi = kHistMax;
-      while (lo < hi) {
-        const int mid = (lo + hi) / 2;
-        if (countAtMost(bins.data(), w, v1 - v0, u0, u1, std::uint8_t(mid)) > half) {
-          hi = mid;
-        } else {
-          lo = mid + 1;
-        }
-      }
+      const int lo = medianBin(bins, w, v1 - v0, u0, u1);
       median[static_cast<std::size_t>(b) * bx + a] = static_cast<float>(lo);
       has_pixels[static_cast<std::size_t>(b) * bx + a] = 1;
     }

@@ -187,48 +187,71 @@ std::string tumCameraOfName(const std::string& folder_name) {
   return std::regex_search(folder_name, match, tum) ? "fr" + match[3].str() : std::string();
 }
 
-TumDataset::TumDataset(const std::string& folder, const std::string& camera) : folder_(folder) {
-  const fs::path dir(folder);
-  if (!fs::is_directory(dir)) throw std::runtime_error("dataset folder " + folder + " not found");
+namespace {
 
+// A dataset's camera: its intrinsics, lens distortion and the TUM camera its folder is named
+// for (empty: none).
+struct DatasetCamera {
+  Camera camera;
+  LensDistortion distortion;
+  std::string named;
+};
+
+// The camera of the dataset in `dir`, as TumDataset's `camera` argument picks it.
+DatasetCamera datasetCamera(const fs::path& dir, const std::string& camera) {
+  DatasetCamera out;
   if (camera.empty()) {
     const fs::path yaml = dir / "camera.yaml";
     if (fs::exists(yaml)) {
       const CameraFile file = readCameraFile(yaml.string());
-      camera_ = file.camera;
-      distortion_ = file.distortion;
+      out.camera = file.camera;
+      out.distortion = file.distortion;
     } else {
       fs::path name = fs::absolute(dir).lexically_normal();
       if (name.filename().empty()) name = name.parent_path();  // a path ending in '/'
-      named_camera_ = tumCameraOfName(name.filename().string());
-      camera_ = cameraByName(named_camera_.empty() ? "default" : named_camera_);
-      distortion_ = distortionByName(named_camera_);
+      out.named = tumCameraOfName(name.filename().string());
+      out.camera = cameraByName(out.named.empty() ? "default" : out.named);
+      out.distortion = distortionByName(out.named);
     }
   } else if (camera == "fr1" || camera == "fr2" || camera == "fr3" || camera == "default") {
-    camera_ = cameraByName(camera);
-    distortion_ = distortionByName(camera);
+    out.camera = cameraByName(camera);
+    out.distortion = distortionByName(camera);
   } else if (fs::exists(camera)) {
     const CameraFile file = readCameraFile(camera);
-    camera_ = file.camera;
-    distortion_ = file.distortion;
+    out.camera = file.camera;
+    out.distortion = file.distortion;
   } else {
     throw std::runtime_error("camera '" + camera +
                              "' is neither fr1, fr2, fr3, default nor a camera yaml file");
   }
+  return out;
+}
 
+// The frames of the dataset `folder` (in `dir`): its associations.txt, else its rgb.txt and
+// depth.txt associated.
+std::vector<TumAssociation> datasetFrames(const fs::path& dir, const std::string& folder) {
   const fs::path associations = dir / "associations.txt";
-  if (fs::exists(associations)) {
-    frames_ = readAssociations(associations.string());
-  } else {
-    const fs::path rgb = dir / "rgb.txt", depth = dir / "depth.txt";
-    for (const fs::path& list : {rgb, depth}) {
-      if (!fs::exists(list)) {
-        throw std::runtime_error("dataset " + folder + " has neither associations.txt nor " +
-                                 list.filename().string() + " (" + list.string() + ")");
-      }
+  if (fs::exists(associations)) return readAssociations(associations.string());
+  const fs::path rgb = dir / "rgb.txt", depth = dir / "depth.txt";
+  for (const fs::path& list : {rgb, depth}) {
+    if (!fs::exists(list)) {
+      throw std::runtime_error("dataset " + folder + " has neither associations.txt nor " +
+                               list.filename().string() + " (" + list.string() + ")");
     }
-    frames_ = associate(readTumList(rgb.string()), readTumList(depth.string()));
   }
+  return associate(readTumList(rgb.string()), readTumList(depth.string()));
+}
+
+}  // namespace
+
+TumDataset::TumDataset(const std::string& folder, const std::string& camera) : folder_(folder) {
+  const fs::path dir(folder);
+  if (!fs::is_directory(dir)) throw std::runtime_error("dataset folder " + folder + " not found");
+  DatasetCamera found = datasetCamera(dir, camera);
+  camera_ = found.camera;
+  distortion_ = found.distortion;
+  named_camera_ = std::move(found.named);
+  frames_ = datasetFrames(dir, folder);
 
   const fs::path groundtruth = dir / "groundtruth.txt";
   if (fs::exists(groundtruth)) groundtruth_ = readTrajectory(groundtruth.string());

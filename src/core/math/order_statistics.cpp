@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <array>
+#include <cstddef>
 #include <limits>
+#include <utility>
+#include <vector>
 
 namespace acvo {
 namespace {
@@ -51,14 +54,16 @@ double kthSmallest(double* first, double* last, std::size_t k) {
   return first[k];
 }
 
-double weightedMedian(std::vector<std::pair<double, double>>& pairs) {
-  double total = 0.0;
-  for (const auto& p : pairs) total += p.second;
-  const double half = 0.5 * total;
-  auto lo = pairs.begin(), hi = pairs.end();
-  double below = 0.0;     // the weight of the pairs before lo, all smaller
-  double in_range = total;  // the weight of [lo, hi)
-  // Narrowed first as kthSmallest narrows, the pivots around the sample's own crossing.
+namespace {
+
+using PairIterator = std::vector<std::pair<double, double>>::iterator;
+
+// Narrows [lo, hi) (weight in_range, `below` the weight of the smaller pairs before lo) to the
+// pairs between two pivots around the sample's own crossing of `half`, as kthSmallest narrows,
+// while the crossing stays among them and they are fewer: the kept pairs are moved to the front
+// and hi and below follow.
+void narrowToCrossing(PairIterator lo, PairIterator& hi, double& below, double in_range,
+                      double half) {
   while (std::size_t(hi - lo) > kNarrowFrom) {
     const std::size_t n = std::size_t(hi - lo);
     std::array<std::pair<double, double>, kSample> sample;
@@ -83,15 +88,21 @@ double weightedMedian(std::vector<std::pair<double, double>>& pairs) {
       kept += std::size_t(keep);
     }
     // The crossing outside [v_lo, v_hi] (a sample that missed it), or no progress: the
-    // quickselect below on what is left.
+    // quickselect on what is left.
     if (below + w_below >= half || !(below + w_below + w_kept >= half) || kept == n) break;
     below += w_below;
     in_range = w_kept;
     hi = lo + std::ptrdiff_t(kept);
   }
+}
+
+// A weighted quickselect of the crossing of `half` in [lo, hi) (`below` the weight of the
+// smaller pairs before lo): one three-way partition per pass, summing the weights below and at
+// the pivot as it goes. Rounding can leave the crossing past the last pair: the largest of
+// [first, hi) then.
+double weightedQuickselect(PairIterator first, PairIterator lo, PairIterator hi, double below,
+                           double half) {
   const auto end = hi;
-  // A weighted quickselect: one three-way partition per round, summing the weights below and at
-  // the pivot as it goes.
   while (hi - lo > 1) {
     const double a = lo->first, b = lo[(hi - lo) / 2].first, c = (hi - 1)->first;
     const double pivot = std::max(std::min(a, b), std::min(std::max(a, b), c));
@@ -118,8 +129,20 @@ double weightedMedian(std::vector<std::pair<double, double>>& pairs) {
       lo = greater;
     }
   }
-  // Rounding can leave the crossing past the last pair: the largest then.
-  return lo != end ? lo->first : std::max_element(pairs.begin(), end)->first;
+  return lo != end ? lo->first : std::max_element(first, end)->first;
+}
+
+}  // namespace
+
+double weightedMedian(std::vector<std::pair<double, double>>& pairs) {
+  double total = 0.0;
+  for (const auto& p : pairs) total += p.second;
+  const double half = 0.5 * total;
+  const auto lo = pairs.begin();
+  auto hi = pairs.end();
+  double below = 0.0;  // the weight of the pairs before lo, all smaller
+  narrowToCrossing(lo, hi, below, total, half);  // [lo, hi) weighs `total` at first
+  return weightedQuickselect(pairs.begin(), lo, hi, below, half);
 }
 
 }  // namespace acvo
