@@ -252,18 +252,19 @@ void fromString(const std::string& s, Reference& v);
 void fromString(const std::string& s, SyncDepth& v);
 void fromString(const std::string& s, UnregisteredColour& v);
 
-// Calls visit(section, name, field) for every parameter; field is int&, double&, bool& or one
-// of the enums above. Sections: "selection", "registration", "coarse_to_fine", "paper",
-// "odometry".
-template <typename Params_, typename Visitor>
-void visitParams(Params_& p, Visitor&& visit) {
-  visit("selection", "target_points", p.selection.target_points);
-  visit("selection", "min_depth", p.selection.min_depth);
-  visit("selection", "max_depth", p.selection.max_depth);
-  visit("selection", "canny_fallback", p.selection.canny_fallback);
-  visit("selection", "scale_with_image", p.selection.scale_with_image);
-  visit("registration", "engine", p.registration.engine);
-  auto& c = p.coarse_to_fine;
+// visitParams' sections, each with its struct (const or not): visit(section, name, field) for
+// every parameter of the section, in the order of the section's fields.
+template <typename Selection, typename Visitor>
+void visitSelectionParams(Selection& s, Visitor&& visit) {
+  visit("selection", "target_points", s.target_points);
+  visit("selection", "min_depth", s.min_depth);
+  visit("selection", "max_depth", s.max_depth);
+  visit("selection", "canny_fallback", s.canny_fallback);
+  visit("selection", "scale_with_image", s.scale_with_image);
+}
+
+template <typename CoarseToFine, typename Visitor>
+void visitCoarseToFineParams(CoarseToFine& c, Visitor&& visit) {
   visit("coarse_to_fine", "ell_init", c.ell_init);
   visit("coarse_to_fine", "ell_min", c.ell_min);
   visit("coarse_to_fine", "ell_reduction", c.ell_reduction);
@@ -291,7 +292,10 @@ void visitParams(Params_& p, Visitor&& visit) {
   visit("coarse_to_fine", "exposure_time", c.exposure_time);
   visit("coarse_to_fine", "min_points", c.min_points);
   visit("coarse_to_fine", "covariance_scale", c.covariance_scale);
-  auto& a = p.paper;
+}
+
+template <typename Paper, typename Visitor>
+void visitPaperParams(Paper& a, Visitor&& visit) {
   visit("paper", "ell_policy", a.ell_policy);
   visit("paper", "ell_update", a.ell_update);
   visit("paper", "ell_init", a.ell_init);
@@ -314,25 +318,41 @@ void visitParams(Params_& p, Visitor&& visit) {
   visit("paper", "min_points", a.min_points);
   visit("paper", "hard_ell_reductions", a.hard_ell_reductions);
   visit("paper", "covariance_scale", a.covariance_scale);
-  visit("odometry", "initial_guess", p.odometry.initial_guess);
-  visit("odometry", "threads", p.odometry.threads);
-  visit("odometry", "reference", p.odometry.reference);
-  visit("odometry", "keyframe_matched_fraction", p.odometry.keyframe_matched_fraction);
-  visit("odometry", "keyframe_translation", p.odometry.keyframe_translation);
-  visit("odometry", "keyframe_rotation", p.odometry.keyframe_rotation);
-  visit("odometry", "lost_matched_fraction", p.odometry.lost_matched_fraction);
-  visit("odometry", "hard_matched_fraction", p.odometry.hard_matched_fraction);
-  visit("odometry", "max_translation", p.odometry.max_translation);
-  visit("odometry", "max_rotation", p.odometry.max_rotation);
-  visit("odometry", "lost_speed", p.odometry.lost_speed);
-  visit("odometry", "lost_angular_speed", p.odometry.lost_angular_speed);
-  visit("odometry", "sync_depth", p.odometry.sync_depth);
-  visit("odometry", "unregistered_colour", p.odometry.unregistered_colour);
-  visit("odometry", "second_start", p.odometry.second_start);
-  visit("odometry", "second_start_check", p.odometry.second_start_check);
-  visit("odometry", "second_start_memory", p.odometry.second_start_memory);
-  visit("odometry", "turn_start", p.odometry.turn_start);
-  visit("odometry", "rest_start", p.odometry.rest_start);
+}
+
+template <typename Odometry, typename Visitor>
+void visitOdometryParams(Odometry& o, Visitor&& visit) {
+  visit("odometry", "initial_guess", o.initial_guess);
+  visit("odometry", "threads", o.threads);
+  visit("odometry", "reference", o.reference);
+  visit("odometry", "keyframe_matched_fraction", o.keyframe_matched_fraction);
+  visit("odometry", "keyframe_translation", o.keyframe_translation);
+  visit("odometry", "keyframe_rotation", o.keyframe_rotation);
+  visit("odometry", "lost_matched_fraction", o.lost_matched_fraction);
+  visit("odometry", "hard_matched_fraction", o.hard_matched_fraction);
+  visit("odometry", "max_translation", o.max_translation);
+  visit("odometry", "max_rotation", o.max_rotation);
+  visit("odometry", "lost_speed", o.lost_speed);
+  visit("odometry", "lost_angular_speed", o.lost_angular_speed);
+  visit("odometry", "sync_depth", o.sync_depth);
+  visit("odometry", "unregistered_colour", o.unregistered_colour);
+  visit("odometry", "second_start", o.second_start);
+  visit("odometry", "second_start_check", o.second_start_check);
+  visit("odometry", "second_start_memory", o.second_start_memory);
+  visit("odometry", "turn_start", o.turn_start);
+  visit("odometry", "rest_start", o.rest_start);
+}
+
+// Calls visit(section, name, field) for every parameter; field is int&, double&, bool& or one
+// of the enums above. Sections: "selection", "registration", "coarse_to_fine", "paper",
+// "odometry".
+template <typename Params_, typename Visitor>
+void visitParams(Params_& p, Visitor&& visit) {
+  visitSelectionParams(p.selection, visit);
+  visit("registration", "engine", p.registration.engine);
+  visitCoarseToFineParams(p.coarse_to_fine, visit);
+  visitPaperParams(p.paper, visit);
+  visitOdometryParams(p.odometry, visit);
 }
 
 // The paper's A-CVO as the authors' code runs it (config/paper.yaml; docs/method.md §4 says

@@ -124,6 +124,80 @@ void checkKernel(std::ostringstream& why, const std::string& section, double sig
         section + ".sparsification", "must be below sigma^2 * color_sigma^2");
 }
 
+// The checks of each section, in validate's order (the first failure is the one reported).
+void checkSelection(std::ostringstream& why, const SelectionParams& se) {
+  check(why, se.target_points > 0, "selection.target_points", "must be positive");
+  check(why, se.min_depth >= 0.0, "selection.min_depth", "must not be negative");
+  check(why, se.min_depth < se.max_depth, "selection.min_depth", "must be below max_depth");
+}
+
+void checkCoarseToFine(std::ostringstream& why, const CoarseToFineParams& c) {
+  check(why, c.ell_min > 0.0, "coarse_to_fine.ell_min", "must be positive");
+  check(why, c.ell_init >= c.ell_min, "coarse_to_fine.ell_init", "must not be below ell_min");
+  check(why, c.ell_reduction > 0.0 && c.ell_reduction < 1.0, "coarse_to_fine.ell_reduction",
+        "must lie in (0, 1)");
+  checkKernel(why, "coarse_to_fine", c.sigma, c.color_ell, c.color_sigma, c.sparsification);
+  check(why, c.ell_depth_reference >= 0.0, "coarse_to_fine.ell_depth_reference",
+        "must not be negative (0 = off)");
+  check(why, c.depth_noise >= 0.0, "coarse_to_fine.depth_noise", "must not be negative (0 = off)");
+  check(why, c.exposure_time >= 0.0 && c.exposure_time <= 1.0, "coarse_to_fine.exposure_time",
+        "must be within [0, 1] s (0 = sharp images)");
+  check(why, c.grey_smoothing >= 0.0 && c.grey_smoothing <= 5.0, "coarse_to_fine.grey_smoothing",
+        "must lie in [0, 5] px (0 = none)");
+  check(why, c.edge_variance >= 0.0, "coarse_to_fine.edge_variance",
+        "must not be negative (0 = off)");
+  check(why, c.tukey_sigmas >= 0.0, "coarse_to_fine.tukey_sigmas",
+        "must not be negative (0 = least squares)");
+  check(why, c.exact_depth_grid_stride >= 1 && c.exact_depth_grid_stride <= 100,
+        "coarse_to_fine.exact_depth_grid_stride", "must lie in [1, 100] px");
+  check(why, c.level_points > 0, "coarse_to_fine.level_points", "must be positive");
+  check(why, c.level_iterations > 0, "coarse_to_fine.level_iterations", "must be positive");
+  check(why, c.level_eps > 0.0, "coarse_to_fine.level_eps", "must be positive");
+  check(why, c.level_acceleration >= 0.0 && c.level_acceleration < 1.0,
+        "coarse_to_fine.level_acceleration", "must lie in [0, 1)");
+  check(why, c.min_points > 0, "coarse_to_fine.min_points", "must be positive");
+  check(why, c.covariance_scale > 0.0, "coarse_to_fine.covariance_scale", "must be positive");
+}
+
+void checkPaper(std::ostringstream& why, const PaperParams& a) {
+  check(why, a.ell_min > 0.0, "paper.ell_min", "must be positive");
+  check(why, a.ell_min <= a.ell_max, "paper.ell_min", "must not exceed ell_max");
+  check(why, a.ell_init >= a.ell_min && a.ell_init <= a.ell_max, "paper.ell_init",
+        "must lie within [ell_min, ell_max]");
+  check(why, a.ell_step > 0.0, "paper.ell_step", "must be positive");
+  check(why, a.ell_reduction > 0.0 && a.ell_reduction < 1.0, "paper.ell_reduction",
+        "must lie in (0, 1)");
+  checkKernel(why, "paper", a.sigma, a.color_ell, a.color_sigma, a.sparsification);
+  check(why, a.eps_transform > 0.0, "paper.eps_transform", "must be positive");
+  check(why, a.eps_gradient > 0.0, "paper.eps_gradient", "must be positive");
+  check(why, a.min_step > 0.0, "paper.min_step", "must be positive");
+  check(why, a.min_step <= a.max_step, "paper.min_step", "must not exceed max_step");
+  check(why, a.omega_scale > 0.0, "paper.omega_scale", "must be positive");
+  check(why, a.v_scale > 0.0, "paper.v_scale", "must be positive");
+  check(why, a.max_iterations > 0, "paper.max_iterations", "must be positive");
+  check(why, a.min_points > 0, "paper.min_points", "must be positive");
+  check(why, a.hard_ell_reductions > 0, "paper.hard_ell_reductions", "must be positive");
+  check(why, a.covariance_scale > 0.0, "paper.covariance_scale", "must be positive");
+}
+
+void checkOdometry(std::ostringstream& why, const OdometryParams& od) {
+  check(why, od.threads >= -1, "odometry.threads",
+        "must be -1 (all cores but one), 0 (all cores) or a number of threads");
+  check(why,
+        od.lost_matched_fraction >= 0.0 && od.lost_matched_fraction <= od.hard_matched_fraction,
+        "odometry.lost_matched_fraction", "must lie within [0, hard_matched_fraction]");
+  check(why, od.hard_matched_fraction <= 1.0, "odometry.hard_matched_fraction",
+        "must not exceed 1");
+  check(why, od.max_translation > 0.0, "odometry.max_translation", "must be positive");
+  check(why, od.max_rotation > 0.0, "odometry.max_rotation", "must be positive");
+  check(why, od.keyframe_matched_fraction >= 0.0 && od.keyframe_matched_fraction <= 1.0,
+        "odometry.keyframe_matched_fraction", "must lie within [0, 1]");
+  check(why, od.keyframe_translation > 0.0, "odometry.keyframe_translation", "must be positive");
+  check(why, od.keyframe_rotation > 0.0, "odometry.keyframe_rotation", "must be positive");
+  check(why, od.lost_speed >= 0.0, "odometry.lost_speed", "must not be negative");
+  check(why, od.lost_angular_speed >= 0.0, "odometry.lost_angular_speed", "must not be negative");
+}
+
 }  // namespace
 
 std::string toString(Engine v) {
@@ -207,71 +281,10 @@ std::string validate(const Params& p) {
       }
     }
   });
-  const SelectionParams& se = p.selection;
-  check(why, se.target_points > 0, "selection.target_points", "must be positive");
-  check(why, se.min_depth >= 0.0, "selection.min_depth", "must not be negative");
-  check(why, se.min_depth < se.max_depth, "selection.min_depth", "must be below max_depth");
-  const CoarseToFineParams& c = p.coarse_to_fine;
-  check(why, c.ell_min > 0.0, "coarse_to_fine.ell_min", "must be positive");
-  check(why, c.ell_init >= c.ell_min, "coarse_to_fine.ell_init", "must not be below ell_min");
-  check(why, c.ell_reduction > 0.0 && c.ell_reduction < 1.0, "coarse_to_fine.ell_reduction",
-        "must lie in (0, 1)");
-  checkKernel(why, "coarse_to_fine", c.sigma, c.color_ell, c.color_sigma, c.sparsification);
-  check(why, c.ell_depth_reference >= 0.0, "coarse_to_fine.ell_depth_reference",
-        "must not be negative (0 = off)");
-  check(why, c.depth_noise >= 0.0, "coarse_to_fine.depth_noise", "must not be negative (0 = off)");
-  check(why, c.exposure_time >= 0.0 && c.exposure_time <= 1.0, "coarse_to_fine.exposure_time",
-        "must be within [0, 1] s (0 = sharp images)");
-  check(why, c.grey_smoothing >= 0.0 && c.grey_smoothing <= 5.0, "coarse_to_fine.grey_smoothing",
-        "must lie in [0, 5] px (0 = none)");
-  check(why, c.edge_variance >= 0.0, "coarse_to_fine.edge_variance",
-        "must not be negative (0 = off)");
-  check(why, c.tukey_sigmas >= 0.0, "coarse_to_fine.tukey_sigmas",
-        "must not be negative (0 = least squares)");
-  check(why, c.exact_depth_grid_stride >= 1 && c.exact_depth_grid_stride <= 100,
-        "coarse_to_fine.exact_depth_grid_stride", "must lie in [1, 100] px");
-  check(why, c.level_points > 0, "coarse_to_fine.level_points", "must be positive");
-  check(why, c.level_iterations > 0, "coarse_to_fine.level_iterations", "must be positive");
-  check(why, c.level_eps > 0.0, "coarse_to_fine.level_eps", "must be positive");
-  check(why, c.level_acceleration >= 0.0 && c.level_acceleration < 1.0,
-        "coarse_to_fine.level_acceleration", "must lie in [0, 1)");
-  check(why, c.min_points > 0, "coarse_to_fine.min_points", "must be positive");
-  check(why, c.covariance_scale > 0.0, "coarse_to_fine.covariance_scale", "must be positive");
-  const PaperParams& a = p.paper;
-  check(why, a.ell_min > 0.0, "paper.ell_min", "must be positive");
-  check(why, a.ell_min <= a.ell_max, "paper.ell_min", "must not exceed ell_max");
-  check(why, a.ell_init >= a.ell_min && a.ell_init <= a.ell_max, "paper.ell_init",
-        "must lie within [ell_min, ell_max]");
-  check(why, a.ell_step > 0.0, "paper.ell_step", "must be positive");
-  check(why, a.ell_reduction > 0.0 && a.ell_reduction < 1.0, "paper.ell_reduction",
-        "must lie in (0, 1)");
-  checkKernel(why, "paper", a.sigma, a.color_ell, a.color_sigma, a.sparsification);
-  check(why, a.eps_transform > 0.0, "paper.eps_transform", "must be positive");
-  check(why, a.eps_gradient > 0.0, "paper.eps_gradient", "must be positive");
-  check(why, a.min_step > 0.0, "paper.min_step", "must be positive");
-  check(why, a.min_step <= a.max_step, "paper.min_step", "must not exceed max_step");
-  check(why, a.omega_scale > 0.0, "paper.omega_scale", "must be positive");
-  check(why, a.v_scale > 0.0, "paper.v_scale", "must be positive");
-  check(why, a.max_iterations > 0, "paper.max_iterations", "must be positive");
-  check(why, a.min_points > 0, "paper.min_points", "must be positive");
-  check(why, a.hard_ell_reductions > 0, "paper.hard_ell_reductions", "must be positive");
-  check(why, a.covariance_scale > 0.0, "paper.covariance_scale", "must be positive");
-  const OdometryParams& od = p.odometry;
-  check(why, od.threads >= -1, "odometry.threads",
-        "must be -1 (all cores but one), 0 (all cores) or a number of threads");
-  check(why,
-        od.lost_matched_fraction >= 0.0 && od.lost_matched_fraction <= od.hard_matched_fraction,
-        "odometry.lost_matched_fraction", "must lie within [0, hard_matched_fraction]");
-  check(why, od.hard_matched_fraction <= 1.0, "odometry.hard_matched_fraction",
-        "must not exceed 1");
-  check(why, od.max_translation > 0.0, "odometry.max_translation", "must be positive");
-  check(why, od.max_rotation > 0.0, "odometry.max_rotation", "must be positive");
-  check(why, od.keyframe_matched_fraction >= 0.0 && od.keyframe_matched_fraction <= 1.0,
-        "odometry.keyframe_matched_fraction", "must lie within [0, 1]");
-  check(why, od.keyframe_translation > 0.0, "odometry.keyframe_translation", "must be positive");
-  check(why, od.keyframe_rotation > 0.0, "odometry.keyframe_rotation", "must be positive");
-  check(why, od.lost_speed >= 0.0, "odometry.lost_speed", "must not be negative");
-  check(why, od.lost_angular_speed >= 0.0, "odometry.lost_angular_speed", "must not be negative");
+  checkSelection(why, p.selection);
+  checkCoarseToFine(why, p.coarse_to_fine);
+  checkPaper(why, p.paper);
+  checkOdometry(why, p.odometry);
   return why.str();
 }
 
