@@ -1,4 +1,5 @@
-// The odometry pipeline (odometry.hpp, docs/method.md §7).
+// The odometry pipeline (odometry.hpp, docs/method.md §7); what it does about the colour camera
+// is in colour_camera.cpp.
 #include "acvo/odometry/odometry.hpp"
 
 #include <algorithm>
@@ -54,13 +55,6 @@ std::string whyTooFewPoints(const CloudStats& stats, const SelectionParams& p) {
 }
 
 }  // namespace
-
-Frame depthAsRegistered(const Frame& frame, const OdometryResult& r) {
-  if (!r.cloud || r.cloud->depth.empty()) return frame;
-  Frame out = frame;
-  out.depth = r.cloud->depth;
-  return out;
-}
 
 Odometry::Odometry(const Params& params)
     : params_(params),
@@ -351,33 +345,6 @@ void Odometry::lost(OdometryResult& r, const Registration& reg, double stamp) {
   }
 }
 
-void Odometry::lookAtColour(const Frame& frame, OdometryResult& r) {
-  if (r.tracking == Tracking::kBadFrame) return;
-  const bool had = colour_.ratio().has_value();
-  if (!colour_.look(depthAsRegistered(frame, r), r.frame_index)) return;
-  r.colour_verdict_now = true;
-  if (had != colour_.ratio().has_value()) makeEngine();
-  if (!colour_.ratio() || !last_ || last_->index != r.frame_index) return;
-  // This frame becomes the keyframe, its cloud built again from its colour resampled: the next
-  // frame, resampled, registered to a keyframe of colour as it came would pair each texture
-  // with where it was not.
-  OdometryResult again;
-  Tracked rebuilt = *last_;
-  rebuilt.cloud = asReference(again, buildCloud(colour_.prepared(frame), again));
-  rebuilt.to_keyframe = Eigen::Isometry3d::Identity();
-  rebuilt.to_keyframe_covariance = Matrix6d::Zero();
-  keyframe_ = last_ = rebuilt;
-  r.new_keyframe = true;
-  r.ms_cloud += again.ms_cloud;
-  r.ms_prepare += again.ms_prepare;
-}
-
-void Odometry::makeEngine() {
-  // A keyframe prepared by the other engine serves either (the dense term waits for a keyframe
-  // with a depth grid); the verdict's frame is rebuilt as the keyframe (lookAtColour).
-  engine_ = makeRegistrationEngine(engineParams());
-}
-
 void Odometry::reset(const Eigen::Isometry3d& pose, const Matrix6d& covariance) {
   pose_ = pose;
   pose_covariance_ = covariance;
@@ -398,21 +365,6 @@ std::optional<double> Odometry::lastTrackedStamp() const {
 
 const LabelledCloud* Odometry::keyframeCloud() const {
   return keyframe_ ? &keyframe_->cloud->cloud : nullptr;
-}
-
-std::string Odometry::describeColour() const {
-  std::string text = colour_.describe();
-  const std::string changed = describeChanges(params_, engineParams(), '/');
-  if (!changed.empty()) text += "; the engine's parameters now: " + changed;
-  return text;
-}
-
-void Odometry::newCamera() { takeColourCheck(ColourDepthCheck()); }
-
-void Odometry::takeColourCheck(const ColourDepthCheck& check) {
-  const bool had = colour_.ratio().has_value();
-  colour_.take(check);
-  if (had != colour_.ratio().has_value()) makeEngine();
 }
 
 std::optional<Vector6d> Odometry::lastVelocity() const {
