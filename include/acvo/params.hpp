@@ -101,7 +101,7 @@ struct CoarseToFineParams {
   // of the reference's turn), the plane residuals measured in the reference's image are not;
   // where the colour's residuals stand beside the kernel they correct the pull, where the colour
   // is from another camera they cannot. The odometry turns it on, with photometric off, where
-  // it resamples such colour (docs/accuracy.md, twenty-ninth round).
+  // it resamples such colour.
   bool depth_led = false;
   // The photometric term measures each frame's brightness against the reference's (the median
   // ratio of their grey values at the points it compares) and compares grey values at that
@@ -204,14 +204,13 @@ struct OdometryParams {
   // kSecondStartMemory of a frame that kept one). A person crossing a third of the view can
   // pull the coarse levels, whose kernel spans both motions, into the person's motion; the
   // finest level's narrow kernel, started from the camera's own predicted motion, holds the
-  // still part (docs/accuracy.md, eighteenth round). A miss under those limits but unusual for
-  // the camera (kSecondStartCheckSigmas times its recent velocity changes over the interval) is
-  // run again too, kept only where it scores kSecondStartCheckMargin times the first (a person
-  // entering the view of a smooth camera; twenty-second round). Where no motion is known yet
-  // (the first frame, the first after a lost one) and over kRestFraction of the points disagree
-  // with the reference, those points are registered alone, and that result is kept where
-  // kRestMargin times as many of the image's pixels agree with it (a person in view from the
-  // start; twenty-third round). Off: the paper's single start.
+  // still part. A miss under those limits but unusual for the camera (kSecondStartCheckSigmas
+  // times its recent velocity changes over the interval) is run again too, kept only where it
+  // scores kSecondStartCheckMargin times the first (a person entering the view of a smooth
+  // camera). Where no motion is known yet (the first frame, the first after a lost one) and over
+  // kRestFraction of the points disagree with the reference, those points are registered alone,
+  // and that result is kept where kRestMargin times as many of the image's pixels agree with it
+  // (a person in view from the start). Off: the paper's single start.
   bool second_start = true;
   // Parts of the second start, each on its own (all need second_start):
   //  - second_start_check: a miss under the limits but unusual for this camera (more than

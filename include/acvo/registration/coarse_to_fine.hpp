@@ -31,8 +31,7 @@ bool directTerms(const CoarseToFineParams& p);
 // kernel's depth_noise, or 0 (no fade: each term at its learned scale's weight) when the last
 // level is led by the depth (CoarseToFineParams::depth_led), where the kernel's quadratic
 // counts kDepthLedKernelShare of its weight: the best of 1, 0.5, 0.3, 0.1 and 0 on kitchen7s_dev
-// and on eight rendered rooms of colour from another camera together (docs/accuracy.md,
-// twenty-ninth round).
+// and on eight rendered rooms of colour from another camera together.
 double planeFadeNoise(const CoarseToFineParams& p);
 constexpr double kDepthLedKernelShare = 0.3;
 // The photometric term's two directions (photometricSums, reversePhotometricSums) compare the
@@ -41,7 +40,7 @@ constexpr double kDepthLedKernelShare = 0.3;
 // alone (translation / rotation): a share of 0.5 0.90 / 0.92, 0.6 0.93 / 0.95, 0.7 0.93 / 0.93,
 // the reverse alone 0.96 / 0.93; at 0.5 and 0.6 a person walking slowly into the view pulls
 // each frame by less than the second start's check and is followed (w62's frames 170-250:
-// 0.0034 -> 0.0082 m/s), from 0.7 up it is not (docs/accuracy.md, thirty-first round).
+// 0.0034 -> 0.0082 m/s), from 0.7 up it is not.
 constexpr double kReverseShare = 0.7;
 
 // The length-scales of the levels: ell_init, ell_init * ell_reduction, ... down to ell_min

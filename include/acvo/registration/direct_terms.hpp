@@ -18,6 +18,8 @@
 // variance s^2 (plus, for a grey value, its gradient squared times the 1/12 px^2 to which an
 // edge's position is known) and Tukey's biweight to 8 standard deviations: a residual beyond
 // them (a person crossing the view) no longer pulls.
+// Implemented in src/core/registration, one file per part: direct_images.cpp (images, landings),
+// depth_grid.cpp, brightness.cpp, motion_blur.cpp, photometric.cpp and point_to_plane.cpp.
 #pragma once
 
 #include <cmath>
@@ -39,10 +41,10 @@ namespace acvo {
 // The depth of a frame on a grid of pixels, for the dense point-to-plane term. Each point is the
 // mean of the (2 kGridWindow + 1)^2 window around a grid pixel, over the pixels of its surface
 // (at least half the window). Averaging n pixels divides independent noise by sqrt(n) and
-// does nothing to noise that neighbours share; a real structured-light sensor's comes in blobs
-// (docs/accuracy.md, tenth round), a simulator's is drawn per pixel. Both are told apart on the
-// frame itself, from the twist z00 - z01 - z10 + z11 (blind to any plane) of single pixels
-// (t) and of the four 3x3 quarter means of each window (T): independent noise gives
+// does nothing to noise that neighbours share; a real structured-light sensor's comes in blobs,
+// a simulator's is drawn per pixel. Both are told apart on the frame itself, from the twist
+// z00 - z01 - z10 + z11 (blind to any plane) of single pixels (t) and of the four 3x3 quarter
+// means of each window (T): independent noise gives
 // var(t) = 9 var(T), noise in blobs var(t) << 9 var(T).
 struct DepthGrid {
   std::vector<Eigen::Vector3d> points;  // the window means, camera frame
@@ -65,7 +67,7 @@ constexpr int kGridStride = 10;  // pixels between grid points (3072 on a 640x48
 // ... where the depth is exact, its shared noise under kExactDepthNoise times the modelled depth
 // noise (rendered: at most 0.00006 exact, at least 0.0017 with noise per pixel or in blobs;
 // a Kinect's 0.002): 12288 points. No noise to average, every point is a constraint, as each of
-// ICPOdometry's pixels is (docs/accuracy.md, thirty-fifth round).
+// ICPOdometry's pixels is.
 constexpr int kExactGridStride = 5;  // CoarseToFineParams::exact_depth_grid_stride's default
 constexpr double kExactDepthNoise = 0.1;
 constexpr int kGridWindow = 3;   // a window's half size: 7x7 pixels
