@@ -168,11 +168,14 @@ const Entry* entryNamed(const std::vector<Entry>& entries, const std::string& na
 }  // namespace
 
 acvo::AcvoConfig toConfig(const acvo::Params& params, LostOdom lost_odom) {
+  std::set<std::string> named;  // by the .cfg
+  for (const auto& d : acvo::AcvoConfig::__getParamDescriptions__()) named.insert(d->name);
   dynamic_reconfigure::Config msg;
   acvo::visitParams(params, [&](const std::string& section, const std::string& key,
                                 const auto& field) {
     using T = std::decay_t<decltype(field)>;
     const std::string name = reconfigureName(section, key);
+    if (!named.count(name)) return;
     if constexpr (std::is_same_v<T, bool>) {
       put(msg.bools, name, field);
     } else if constexpr (std::is_same_v<T, int>) {
@@ -184,9 +187,11 @@ acvo::AcvoConfig toConfig(const acvo::Params& params, LostOdom lost_odom) {
     }
   });
   put(msg.strs, "lost_odom", toString(lost_odom));
-  // Takes the entries the .cfg names and ignores the rest.
+  // Only the entries the .cfg names: __fromMessage__ takes them and logs an error for any other.
   acvo::AcvoConfig config = acvo::AcvoConfig::__getDefault__();
-  config.__fromMessage__(msg);
+  if (!config.__fromMessage__(msg)) {
+    throw std::logic_error("toConfig: a parameter the .cfg does not name reached the message");
+  }
   return config;
 }
 
