@@ -120,6 +120,15 @@ TEST(NumericFaults, NaNAndInfInAFrameGiveAFinitePoseOrABadFrame) {
     EXPECT_EQ(r.tracking, Tracking::kBadFrame);
     EXPECT_NE(r.message.find("intrinsics"), std::string::npos) << r.message;
   }
+  // A non-finite depth stamp: a bad frame naming it (it once moved the depth by a NaN delay
+  // and came out lost, "no valid depth").
+  for (const double bad : {double(kNaN), double(kInf)}) {
+    Frame f = seq.frame(2).toFrame();
+    f.depth_stamp = bad;
+    r = odo.process(f);
+    EXPECT_EQ(r.tracking, Tracking::kBadFrame) << r.message;
+    EXPECT_NE(r.message.find("depth_stamp is not finite"), std::string::npos) << r.message;
+  }
   EXPECT_TRUE(odo.pose().matrix().allFinite());
 }
 

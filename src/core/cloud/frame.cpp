@@ -29,6 +29,11 @@ std::string Frame::problem() const {
   if (!camera.valid()) return "camera intrinsics are invalid (zero or non-finite focal length)";
   // A NaN stamp would enter every later interval and covariance growth until a reset.
   if (!std::isfinite(stamp)) return "stamp is not finite";
+  // A non-finite depth stamp would move the depth by a non-finite delay: no point left.
+  if (!std::isfinite(depth_stamp)) {
+    why << "depth_stamp is not finite (" << depth_stamp << ")";
+    return why.str();
+  }
   if (camera.width != color.cols || camera.height != color.rows) {
     why << "camera is " << camera.width << "x" << camera.height << " but the images are "
         << color.cols << "x" << color.rows;
