@@ -169,7 +169,7 @@ struct OdometryParams {
   double keyframe_matched_fraction = 0.5;
   double keyframe_translation = 0.05;  // m
   double keyframe_rotation = 2.0;      // deg
-  int threads = 0;  // 0 = all cores, -1 = all but one (leaves a camera driver a core), n = n
+  int threads = -1;  // -1 = all cores but one (a camera driver keeps a core), 0 = all, n = n
   // Tracking judgement (see odometry.hpp): lost when fewer than this fraction of the frame's
   // points found a kernel partner at the solution (nothing in common), or when a frame-to-frame
   // motion exceeds the limits below; hard to track below hard_matched_fraction.
