@@ -2,9 +2,11 @@
 // labelled cloud, a per-frame report and diagnostics out. The nodelet converts messages, calls
 // acvo::Odometry and publishes; the method lives in the core library.
 //
-// One frame's path: onFrame (lock) -> processFrame: stamp rules, conversion (a rejection is
-// handled in reject(), the one place), the camera-to-base transform, the motion guess from TF,
-// the odometry, then publish() and publishInfo().
+// One frame's path: onFrame (lock) -> processFrame: stamp rules, conversion, the camera-to-base
+// transform, the motion guess from TF, the odometry, then publish() and publishInfo(). A frame
+// that is not processed (its stamp, its messages, the odometry's own checks, an exception) goes
+// through reject(), the one place: a named cause in odom_info, the log and diagnostics. Only
+// frames dropped on request (pause_odom) are not reported one by one.
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -92,7 +94,9 @@ class OdometryNodelet : public nodelet::Nodelet {
   void onFrame(const ImageConstPtr& rgb, const ImageConstPtr& depth,
                const CameraInfoConstPtr& info);
   void processFrame(const Image& rgb, const Image& depth, const Info& info);
-  bool acceptStamp(const ros::Time& stamp);
+  // Applies the stamp rules (stamp_check.hpp); false with the reason in *why for a frame to
+  // drop.
+  bool acceptStamp(const ros::Time& stamp, std::string* why);
   void reject(const std_msgs::Header& header, const std::string& why, double ms_total);
   // Logs the intrinsics in use when they are new: at the first frame and at a change.
   void noteCamera(const acvo::Camera& camera, const Info& info);
@@ -145,9 +149,10 @@ class OdometryNodelet : public nodelet::Nodelet {
   // Counts, for odom_info, diagnostics and the no-data warning. The message counts are
   // incremented by the subscribers' callbacks, outside the mutex.
   struct Counters {
-    std::uint64_t frames = 0;  // frames given to the odometry
+    std::uint64_t frames = 0;  // frames the odometry processed (not rejected)
     std::uint32_t lost = 0;
-    std::uint64_t paused = 0;  // synchronised frames dropped while paused
+    std::uint64_t rejected = 0;  // frames that went through reject()
+    std::uint64_t paused = 0;    // synchronised frames dropped while paused
     std::atomic<std::uint64_t> rgb{0}, depth{0}, info{0};
   };
   // What the last frame left, for diagnostics.
@@ -339,7 +344,10 @@ void OdometryNodelet::processFrame(const Image& rgb, const Image& depth, const I
   }
   std_msgs::Header header = rgb.header;
   header.frame_id = stripSlash(rgb.header.frame_id);
-  if (!acceptStamp(header.stamp)) return;
+  if (std::string why; !acceptStamp(header.stamp, &why)) {
+    reject(header, why, acvo::msSince(start));
+    return;
+  }
 
   std::variant<acvo::Frame, Rejection> converted =
       frameFromMessages(rgb, depth, info, settings_.intrinsics, topics_);
@@ -380,7 +388,6 @@ void OdometryNodelet::processFrame(const Image& rgb, const Image& depth, const I
     tf.motion_guess.reset();
   }
   acvo::OdometryResult r = odometry_->process(frame, tf.motion_guess);
-  ++count_.frames;
   logColourVerdict(r);
   if (!tf.base_from_camera && r.tracking != acvo::Tracking::kBadFrame) {
     r.message += std::string(r.message.empty() ? "" : "; ") + "not published: no transform from '" +
@@ -405,6 +412,7 @@ void OdometryNodelet::processFrame(const Image& rgb, const Image& depth, const I
     reject(header, r.message, acvo::msSince(start));
     return;
   }
+  ++count_.frames;
   stamps_.processed(header.stamp.toSec());
   const ContinuousOdom::Pose pose =
       continuous_.update(r, tf.motion_guess, header.stamp.toSec(), params_.odometry);
@@ -426,7 +434,7 @@ void OdometryNodelet::processFrame(const Image& rgb, const Image& depth, const I
   publishInfo(r, header, extras);
 }
 
-bool OdometryNodelet::acceptStamp(const ros::Time& stamp) {
+bool OdometryNodelet::acceptStamp(const ros::Time& stamp, std::string* why) {
   const double last = stamps_.last();
   switch (stamps_.check(stamp.toSec(), settings_.max_time_gap, kTimeJumpBack)) {
     case StampVerdict::kAccept:
@@ -437,10 +445,15 @@ bool OdometryNodelet::acceptStamp(const ros::Time& stamp) {
                             "guess may be poor",
                             stamp.toSec() - last, settings_.max_time_gap);
       return true;
-    case StampVerdict::kDrop:
-      NODELET_WARN_THROTTLE(5.0, "dropping a frame whose stamp %.6f is not after the last one %.6f",
-                            stamp.toSec(), last);
+    case StampVerdict::kDrop: {
+      char text[160];
+      std::snprintf(text, sizeof text,
+                    "stamp %.6f is not after the last processed frame's, %.6f (a repeated or "
+                    "reordered frame)",
+                    stamp.toSec(), last);
+      *why = text;
       return false;
+    }
     case StampVerdict::kRestart:
       if (ros::Time::isSimTime()) {
         // A bag played again (rosbag play --loop --clock): the run starts over, from the start
@@ -506,6 +519,7 @@ void OdometryNodelet::logColourVerdict(const acvo::OdometryResult& r) {
 
 void OdometryNodelet::reject(const std_msgs::Header& header, const std::string& why,
                              double ms_total) {
+  ++count_.rejected;
   last_.tracking = acvo::Tracking::kBadFrame;
   last_.message = why;
   if (skip_warnings_.allow(why, ros::WallTime::now().toSec())) {
@@ -801,6 +815,7 @@ void OdometryNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& stat
   stat.add("seconds since last frame", silent);
   stat.add("frames processed", count_.frames);
   stat.add("frames lost", count_.lost);
+  stat.add("frames rejected", count_.rejected);
   stat.add("frames dropped while paused", count_.paused);
   stat.add("last tracking", acvo::toString(last_.tracking));
   stat.add("last message", last_.message);

@@ -412,6 +412,25 @@ class Client {
     }
     return std::nullopt;
   }
+  // The value of `key` in the first odometry diagnostic received after `since` (wall).
+  std::optional<std::string> diagnosticValueAfter(const std::string& key,
+                                                  const ros::WallTime& since,
+                                                  double timeout = 5.0) {
+    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(timeout);
+    while (ros::WallTime::now() < deadline) {
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (last_diag_ && last_diag_wall_ > since) {
+          for (const auto& kv : last_diag_->values) {
+            if (kv.key == key) return kv.value;
+          }
+          return std::nullopt;
+        }
+      }
+      ros::WallDuration(0.05).sleep();
+    }
+    return std::nullopt;
+  }
   // The value of `key` once `done` holds for it, or the last one seen after `timeout` s
   // (diagnostics come once a second).
   template <typename Done>
@@ -1125,31 +1144,56 @@ TEST(OdometryNodelet, BadInputIsNamedAndSkippedAndTheNodeCarriesOn) {
                  "after bad frames");
 }
 
-TEST(OdometryNodelet, StampsRepeatedAreDroppedAndAJumpBackKeepsThePose) {
+// A frame whose stamp is not after the last processed one is not processed, and goes the way of
+// every frame that is not: odom_info says bad_frame and why, the log says it (throttled per
+// cause), diagnostics count it. Before, such a frame left only a throttled log line.
+TEST(OdometryNodelet, StampsRepeatedAreRejectedNamedAndAJumpBackKeepsThePose) {
   if (!client->exact_stamps_) {
     GTEST_SKIP() << "approximate sync drops reordered stamps itself; run with exact sync";
   }
   ASSERT_TRUE(client->reset());
   std::vector<ros::Time> stamps;
   client->run(range(0, 3), &stamps);
-  // The same stamp again: dropped before it reaches the odometry (no second odom_info).
+  const long rejected_before = std::stol(client->diagnosticValueAfter(
+      "frames rejected", ros::WallTime::now()).value_or("-1000"));
+  EXPECT_GE(rejected_before, 0) << "no \"frames rejected\" in diagnostics";
+  // The same stamp again: rejected before it reaches the odometry (a second odom_info, which
+  // says so).
   ASSERT_EQ(client->infoCount(stamps.back()), 1);
+  const ros::WallTime since = ros::WallTime::now();
   client->send(client->frame(3), stamps.back());
   // A later frame shows the node still processes frames, and gives the repeat time to arrive.
   const ros::Time later = client->nextStamp();
   client->send(client->frame(3), later);
   ASSERT_TRUE(client->outcome(later, true).odom);
-  EXPECT_EQ(client->infoCount(stamps.back()), 1) << "a repeated stamp was processed";
-  // A stamp a little before the last one (reordered): dropped too, with a warning.
+  ASSERT_EQ(client->infoCount(stamps.back()), 2) << "a repeated stamp went unreported";
+  const Outcome repeat = client->outcome(stamps.back(), false);
+  EXPECT_EQ(repeat.info->tracking, "bad_frame");
+  EXPECT_NE(repeat.info->message.find("is not after the last processed frame's"),
+            std::string::npos)
+      << repeat.info->message;
+  // A stamp a little before the last one (reordered): rejected too.
   const ros::Time earlier = later - ros::Duration(0.05);
-  const ros::WallTime since = ros::WallTime::now();
   client->send(client->frame(4), earlier);
   const ros::Time after = client->nextStamp();
   client->send(client->frame(4), after);
   ASSERT_TRUE(client->outcome(after, true).odom);
-  EXPECT_EQ(client->infoCount(earlier), 0) << "a stamp before the last one was processed";
-  // (The warning is throttled: the one for the repeat above or this one.)
-  EXPECT_TRUE(client->waitLog("is not after the last one", since - ros::WallDuration(10.0)));
+  ASSERT_EQ(client->infoCount(earlier), 1) << "a stamp before the last one went unreported";
+  const Outcome reordered = client->outcome(earlier, false);
+  EXPECT_EQ(reordered.info->tracking, "bad_frame") << "a stamp before the last one was processed";
+  EXPECT_NE(reordered.info->message.find("a repeated or reordered frame"), std::string::npos)
+      << reordered.info->message;
+  EXPECT_FALSE(reordered.odom);
+  // The log says it (throttled per cause: once for the two), and diagnostics count both.
+  const auto logged = client->waitLog("frame skipped: stamp ", since);
+  ASSERT_TRUE(logged) << "no warning on /rosout";
+  EXPECT_NE(logged->find("is not after the last processed frame's"), std::string::npos)
+      << *logged;
+  const auto rejected = client->diagnosticValueOnce("frames rejected", [&](const std::string& v) {
+    return std::stol(v) >= rejected_before + 2;
+  });
+  ASSERT_TRUE(rejected);
+  EXPECT_EQ(std::stol(*rejected), rejected_before + 2);
   const Outcome before = client->outcome(after, true);
   ASSERT_TRUE(before.odom);
   // A stamp 5 s in the past on a live clock (this test's stamps are the wall clock's): a
@@ -1179,7 +1223,9 @@ TEST(OdometryNodelet, StampsRepeatedAreDroppedAndAJumpBackKeepsThePose) {
   client->send(client->frame(5), loop2);
   const Outcome looped = client->outcome(loop2, true);
   ASSERT_TRUE(looped.info) << "the looped stream stalled";
-  EXPECT_EQ(client->infoCount(loop1), 0) << "the first frame behind is dropped";
+  const Outcome behind = client->outcome(loop1, false);
+  ASSERT_TRUE(behind.info) << "the first frame behind went unreported";
+  EXPECT_EQ(behind.info->tracking, "bad_frame") << "the first frame behind is dropped";
   EXPECT_EQ(looped.info->tracking, "first_frame");
   ASSERT_TRUE(looped.odom);
   expectPoseNear(looped.odom->pose.pose, toEigen(at_b2.odom->pose.pose), kExactPose, "after a short loop");
