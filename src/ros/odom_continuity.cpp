@@ -11,6 +11,11 @@ ContinuousOdom::Pose ContinuousOdom::update(const acvo::OdometryResult& r,
   const Eigen::Isometry3d dead_reckoned =
       reference_ * (guess ? *guess : Eigen::Isometry3d::Identity());
   const bool tracked = r.tracking == acvo::Tracking::kOk || r.tracking == acvo::Tracking::kHard;
+  if (r.tracking == acvo::Tracking::kFirstFrame && published_) {
+    // The odometry restarted from its own pose (new parameters, a live clock stepping back),
+    // which is the held one while lost: go on from what was published, dead-reckoned or not.
+    correction_ = *published_ * r.pose.inverse();
+  }
   const bool continuous_by_correction =
       r.tracking == acvo::Tracking::kFirstFrame || (tracked && !lost_) ||
       (tracked && lost_reference_ && r.keyframe_index == *lost_reference_);
@@ -42,6 +47,7 @@ ContinuousOdom::Pose ContinuousOdom::update(const acvo::OdometryResult& r,
     reference_ = out.pose;
     reference_stamp_ = stamp;
   }
+  published_ = out.pose;
   return out;
 }
 

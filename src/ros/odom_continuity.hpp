@@ -7,7 +7,10 @@
 //  - on recovery, publishing continues from there: the correction absorbs the jump, and the
 //    motion the camera measures from then on is applied to the published pose;
 //  - the covariance grows while lost (the odometry's lostGrowth) and keeps what a bridged
-//    blackout added, since the published pose did not take the registration's word for it.
+//    blackout added, since the published pose did not take the registration's word for it;
+//  - a restart that keeps the pose (new parameters, a live clock stepping back: the odometry is
+//    reset to its own pose, which is the held one while lost) starts where the last published
+//    pose was, dead-reckoned or not: its first frame takes that pose, not the odometry's.
 // Without a guess, the motion during a blackout is therefore missing from odom (it drifts by
 // it, as REP 105 allows), instead of arriving as a jump.
 // Poses here are camera poses in the odometry's frame (acvo::OdometryResult::pose).
@@ -37,7 +40,8 @@ class ContinuousOdom {
 
   // The odometry was reset to a pose given by the user (or a restarted bag): its poses are
   // published as they are from the next frame on. Not for a restart that keeps the pose (new
-  // parameters, a live clock stepping back): the correction stays and publishing continues.
+  // parameters, a live clock stepping back): without a reset, a first frame is published at the
+  // last published pose and publishing continues from there.
   void reset();
 
   bool lost() const { return lost_; }
@@ -51,6 +55,9 @@ class ContinuousOdom {
   std::optional<std::uint64_t> lost_reference_;
   bool lost_ = false;
   acvo::Matrix6d carried_ = acvo::Matrix6d::Zero();  // what bridged blackouts added
+  // The pose last published (none since the start or a reset): where a first frame without a
+  // reset goes on from.
+  std::optional<Eigen::Isometry3d> published_;
 };
 
 }  // namespace acvo_ros

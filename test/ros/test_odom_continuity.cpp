@@ -100,6 +100,23 @@ TEST_F(Continuity, FramesRegisteredToALostReferenceFollowItsPublishedPose) {
   EXPECT_TRUE(near(back.pose, along(0.35))) << "the measured 5 cm from frame 3, not the guess";
 }
 
+// A restart that keeps the pose (new parameters, a live clock stepping back) while the pose
+// dead-reckons on the guess: the odometry restarts from its own pose, the held one (0.1 m); the
+// published pose goes on from the dead-reckoned 0.3 m instead of snapping back to it.
+TEST_F(Continuity, ARestartThatKeepsThePoseGoesOnFromTheLastPublishedOne) {
+  feed(result(Tracking::kFirstFrame, along(0.0), 0, 0));
+  feed(result(Tracking::kOk, along(0.1), 1, 0));
+  feed(result(Tracking::kLost, along(0.1), 2, 0), along(0.1));
+  EXPECT_TRUE(near(feed(result(Tracking::kLost, along(0.1), 3, 0), along(0.2)).pose, along(0.3)));
+  const ContinuousOdom::Pose restarted = feed(result(Tracking::kFirstFrame, along(0.1), 4, 4, true));
+  EXPECT_TRUE(near(restarted.pose, along(0.3))) << "snapped back to\n" << restarted.pose.matrix();
+  EXPECT_FALSE(odom_.lost());
+  EXPECT_TRUE(near(feed(result(Tracking::kOk, along(0.15), 5, 4)).pose, along(0.35)));
+  // Lost again, then a second restart: from the pose published last, again.
+  EXPECT_TRUE(near(feed(result(Tracking::kLost, along(0.15), 6, 4), along(0.1)).pose, along(0.45)));
+  EXPECT_TRUE(near(feed(result(Tracking::kFirstFrame, along(0.15), 7, 7, true)).pose, along(0.45)));
+}
+
 TEST_F(Continuity, AResetPublishesTheOdometrysPosesAsTheyAre) {
   feed(result(Tracking::kFirstFrame, along(0.0), 0, 0));
   feed(result(Tracking::kLost, along(0.0), 1, 0), along(0.2));

@@ -1284,6 +1284,62 @@ TEST(OdometryNodelet, ReconfigureRestartsTrackingWithNewParametersAndRefusesBadO
   reconfigure("target_points", 3000, true);
 }
 
+// While lost with wheel odometry (guess_frame_id) the published pose dead-reckons on the wheels
+// while the odometry holds the pose of its last tracked frame. A restart that keeps the pose (a
+// parameter changed through dynamic_reconfigure; the live clock stepping back) starts the
+// odometry again from that held pose: what is published must go on from the dead-reckoned pose,
+// not snap back to the held one (it did: the correction was not updated on lost frames that did
+// not become the reference).
+TEST(OdometryNodelet, WithAGuessARestartWhileLostGoesOnFromTheDeadReckonedPose) {
+  if (client->guess_frame_.empty()) GTEST_SKIP() << "needs nodelet_guess.test";
+  ASSERT_TRUE(client->reset());
+  std::vector<Eigen::Isometry3d> wheels;
+  for (int k = 0; k < 12; ++k) wheels.push_back(client->expectedBase(cameraPose(k)));
+  // Frames 0-3 tracked, then 4-6 blank: lost, on the wheels.
+  const auto stretch = [&](int from, int to, int first_blank) {
+    std::vector<RgbdImage> images;
+    std::vector<ros::Time> stamps;
+    std::vector<Eigen::Isometry3d> guesses;
+    for (int k = from; k < to; ++k) {
+      images.push_back(k >= first_blank ? client->blank() : client->frame(k));
+      stamps.push_back(client->nextStamp());
+      guesses.push_back(wheels[k]);
+    }
+    return client->run(images, stamps, guesses);
+  };
+  const std::vector<Outcome> first = stretch(0, 7, 4);
+  for (const Outcome& o : first) ASSERT_TRUE(o.info && o.odom);
+  for (int k = 4; k < 7; ++k) ASSERT_TRUE(first[k].info->lost) << k;
+  const Eigen::Isometry3d held = toEigen(first[3].odom->pose.pose);
+  const Eigen::Isometry3d reckoned = toEigen(first[6].odom->pose.pose);
+  ASSERT_GT((reckoned.translation() - held.translation()).norm(), 0.03)
+      << "three frames of motion on the wheels";
+
+  // A parameter changed while lost: tracking restarts at frame 7 where the pose was published.
+  reconfigure("target_points", 2000, true);
+  const std::vector<Outcome> after_change = stretch(7, 8, 8);
+  ASSERT_TRUE(after_change[0].info && after_change[0].odom);
+  EXPECT_EQ(after_change[0].info->tracking, "first_frame");
+  expectPoseNear(after_change[0].odom->pose.pose, reckoned, kExactPose,
+                 "restart by dynamic_reconfigure while lost on the wheels");
+
+  // Lost again (8-10 on the wheels, from frame 7), then the live clock steps 5 s back.
+  const std::vector<Outcome> second = stretch(8, 11, 8);
+  for (const Outcome& o : second) ASSERT_TRUE(o.info && o.info->lost && o.odom);
+  const Eigen::Isometry3d reckoned_again = toEigen(second.back().odom->pose.pose);
+  ASSERT_GT((reckoned_again.translation() - reckoned.translation()).norm(), 0.03);
+  const ros::Time back = client->nextStamp() - ros::Duration(5.05);
+  client->sendGuess(wheels[11], back);
+  ros::WallDuration(0.02).sleep();
+  client->send(client->frame(11), back);
+  const Outcome stepped = client->outcome(back, true);
+  reconfigure("target_points", 3000, true);
+  ASSERT_TRUE(stepped.info && stepped.odom);
+  EXPECT_EQ(stepped.info->tracking, "first_frame");
+  expectPoseNear(stepped.odom->pose.pose, reckoned_again, kExactPose,
+                 "restart by the live clock stepping back while lost on the wheels");
+}
+
 // Sets one parameter through the dynamic_reconfigure server; `list` is the request's list of
 // that parameter's type (Config::bools, Config::strs, ...).
 template <typename Param, typename Allocator, typename Value>
