@@ -253,23 +253,20 @@ void OdometryNodelet::loadSettings() {
   report(loadNodeletSettings(private_ns, settings_), true);
   NODELET_INFO("nodelet settings: %s", describe(settings_).c_str());
   pending_base_pose_ = settings_.initial_pose;
-  std::vector<std::string> reconfigurable;
+  // dynamic_reconfigure's names and the parameters' keys without their section are told apart
+  // below (sectionlessParameters): not unknown.
+  std::vector<std::string> also_known = sectionlessNames();
   for (const auto& d : acvo::AcvoConfig::__getParamDescriptions__()) {
-    reconfigurable.push_back(d->name);
+    also_known.push_back(d->name);
   }
-  report(unknownParameters(private_ns, reconfigurable), false);
+  report(unknownParameters(private_ns, also_known), false);
 
-  // odometry/threads: acvo.launch passes -1 (every core but one: the nodelet shares its
-  // manager with the camera driver); without it, the config's or the core's default.
-  acvo::Params params;
-  // Each value is checked by itself: a bad one is rejected with its reason, the rest are kept.
-  report(applyRosParams(private_ns, params), true);
-  if (const std::string invalid = acvo::validate(params); !invalid.empty()) {
-    NODELET_ERROR("invalid parameters (%s): using the defaults of acvo::Params instead",
-                  invalid.c_str());
-    params = acvo::Params();
-  }
-  params_ = params;
+  // odometry/threads: the config's (acvo.launch's threads argument when given) or the core's
+  // default, -1: every core but one, which the camera driver in the same manager keeps.
+  // Each value is checked by itself on top of the valid defaults: a bad one is rejected with its
+  // reason, the rest are kept, so the set is always valid.
+  report(applyRosParams(private_ns, params_), true);
+  report(sectionlessParameters(private_ns, params_), false);
   odometry_ = std::make_unique<acvo::Odometry>(params_);
   NODELET_INFO("acvo parameters: %s", describeParams(params_).c_str());
 }

@@ -1,6 +1,8 @@
 #include "ros_params.hpp"
 
+#include <algorithm>
 #include <iomanip>
+#include <map>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -132,6 +134,117 @@ std::vector<std::string> applyRosParams(const XmlRpc::XmlRpcValue& private_ns,
   return problems;
 }
 
+namespace {
+
+// Whether a private parameter's value is `field`'s (a number of either type for a double).
+bool sameValue(const XmlRpcValue& v, bool field) {
+  return v.getType() == XmlRpcValue::TypeBoolean && static_cast<const bool&>(v) == field;
+}
+bool sameValue(const XmlRpcValue& v, int field) {
+  return v.getType() == XmlRpcValue::TypeInt && static_cast<const int&>(v) == field;
+}
+bool sameValue(const XmlRpcValue& v, double field) {
+  if (v.getType() == XmlRpcValue::TypeDouble) return static_cast<const double&>(v) == field;
+  return v.getType() == XmlRpcValue::TypeInt && static_cast<const int&>(v) == field;
+}
+template <typename Enum>
+bool sameValue(const XmlRpcValue& v, Enum field) {
+  return v.getType() == XmlRpcValue::TypeString &&
+         static_cast<const std::string&>(v) == acvo::toString(field);
+}
+
+// A private parameter's value as the user wrote it, for a message.
+std::string valueText(const XmlRpcValue& v) {
+  std::ostringstream out;
+  switch (v.getType()) {
+    case XmlRpcValue::TypeBoolean:
+      out << (static_cast<const bool&>(v) ? "true" : "false");
+      break;
+    case XmlRpcValue::TypeInt:
+      out << static_cast<const int&>(v);
+      break;
+    case XmlRpcValue::TypeDouble:
+      out << static_cast<const double&>(v);
+      break;
+    case XmlRpcValue::TypeString:
+      out << "'" << static_cast<const std::string&>(v) << "'";
+      break;
+    default:
+      out << "(not a single value)";
+  }
+  return out.str();
+}
+
+// The reconfigure name of a parameter: its key, the paper section's with a paper_ prefix
+// (dynamic_reconfigure's names are one flat namespace). The .cfg is the one table of what is
+// reconfigurable; toConfig and fromConfig carry every parameter it names, by that name.
+std::string reconfigureName(const std::string& section, const std::string& key) {
+  return section == "paper" ? "paper_" + key : key;
+}
+
+std::set<std::string> cfgNames() {
+  std::set<std::string> names;
+  for (const auto& d : acvo::AcvoConfig::__getParamDescriptions__()) names.insert(d->name);
+  return names;
+}
+
+}  // namespace
+
+std::vector<std::string> sectionlessParameters(const XmlRpc::XmlRpcValue& private_ns,
+                                               const acvo::Params& params) {
+  std::vector<std::string> problems;
+  if (private_ns.getType() != XmlRpcValue::TypeStruct) return problems;
+  const std::set<std::string> reconfigurable = cfgNames();
+  // Per top-level name found: the parameters it may stand for, and whether its value is the
+  // one in use of the parameter the reconfigure server shows under that name.
+  struct Found {
+    std::vector<std::string> keys;  // "section/key"
+    std::string reconfigured;       // the key the server shows under this name, if any
+    bool servers_own = false;
+  };
+  std::map<std::string, Found> found;
+  acvo::visitParams(params, [&](const std::string& section, const std::string& key,
+                                const auto& field) {
+    const std::string reconfigure = reconfigureName(section, key);
+    for (const std::string& name : {key, reconfigure}) {
+      if (!private_ns.hasMember(name)) continue;
+      Found& f = found[name];
+      const std::string full = section + "/" + key;
+      if (std::find(f.keys.begin(), f.keys.end(), full) == f.keys.end()) f.keys.push_back(full);
+      if (name == reconfigure && reconfigurable.count(name)) {
+        f.reconfigured = full;
+        f.servers_own = sameValue(private_ns[name], field);
+      }
+    }
+  });
+  for (const auto& [name, f] : found) {
+    if (f.servers_own) continue;
+    std::string keys;
+    for (std::size_t k = 0; k < f.keys.size(); ++k) {
+      keys += (k == 0 ? "~" : " or ~") + f.keys[k];
+    }
+    std::string problem = "~" + name + " = " + valueText(private_ns[name]) +
+                          " is not read (ignored): the parameter is " + keys;
+    if (!f.reconfigured.empty()) {
+      problem += "; dynamic_reconfigure shows ~" + f.reconfigured + " as " + name +
+                 " and starts it from ~" + f.reconfigured + ", not from ~" + name;
+    }
+    problems.push_back(problem);
+  }
+  return problems;
+}
+
+std::vector<std::string> sectionlessNames() {
+  std::set<std::string> names;
+  const acvo::Params defaults;
+  acvo::visitParams(defaults, [&](const std::string& section, const std::string& key,
+                                  const auto&) {
+    names.insert(key);
+    names.insert(reconfigureName(section, key));
+  });
+  return {names.begin(), names.end()};
+}
+
 std::string describeParams(const acvo::Params& params) {
   std::string out;
   for (const auto& [name, value] : acvo::paramTexts(params, '/')) {
@@ -141,13 +254,6 @@ std::string describeParams(const acvo::Params& params) {
 }
 
 namespace {
-
-// The reconfigure name of a parameter: its key, the paper section's with a paper_ prefix
-// (dynamic_reconfigure's names are one flat namespace). The .cfg is the one table of what is
-// reconfigurable; these two functions carry every parameter it names, by that name.
-std::string reconfigureName(const std::string& section, const std::string& key) {
-  return section == "paper" ? "paper_" + key : key;
-}
 
 template <typename Entry, typename Value>
 void put(std::vector<Entry>& entries, const std::string& name, const Value& value) {
@@ -168,8 +274,7 @@ const Entry* entryNamed(const std::vector<Entry>& entries, const std::string& na
 }  // namespace
 
 acvo::AcvoConfig toConfig(const acvo::Params& params, LostOdom lost_odom) {
-  std::set<std::string> named;  // by the .cfg
-  for (const auto& d : acvo::AcvoConfig::__getParamDescriptions__()) named.insert(d->name);
+  const std::set<std::string> named = cfgNames();
   dynamic_reconfigure::Config msg;
   acvo::visitParams(params, [&](const std::string& section, const std::string& key,
                                 const auto& field) {

@@ -1,7 +1,7 @@
 // acvo::Params from the ROS parameter server and from dynamic_reconfigure.
 //
 // The private namespace holds the same sections and keys as config/acvo.yaml
-// (~selection/target_points, ~solver/ell_policy as a string, ...): the nodelet walks
+// (~selection/target_points, ~paper/ell_policy as a string, ...): the nodelet walks
 // acvo::visitParams, so a key added to the core is read here without a change.
 #pragma once
 
@@ -21,6 +21,18 @@ namespace acvo_ros {
 // keeps its previous value) or an unknown key in a section (ignored). Does not validate().
 std::vector<std::string> applyRosParams(const XmlRpc::XmlRpcValue& private_ns,
                                         acvo::Params& params);
+
+// One sentence per top-level private parameter that is a parameter's key without its section,
+// or its dynamic_reconfigure name (`~target_points` for `~selection/target_points`,
+// `~paper_ell_init` for `~paper/ell_init`): nothing reads it, and it names `~section/key`, the
+// name that is read. The reconfigure server writes its names into the private namespace itself,
+// with the values in use: a reconfigure name whose value is that of `params` (the parameters in
+// use) is not reported.
+std::vector<std::string> sectionlessParameters(const XmlRpc::XmlRpcValue& private_ns,
+                                               const acvo::Params& params);
+// The top-level names sectionlessParameters looks at (every key and reconfigure name), for
+// unknownParameters' `also_known`.
+std::vector<std::string> sectionlessNames();
 
 // "section/name=value ..." for every parameter: logged at start and compared to detect a change.
 std::string describeParams(const acvo::Params& params);

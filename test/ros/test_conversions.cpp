@@ -612,6 +612,50 @@ TEST(RosParams, UnknownNamesAreReportedWithTheNameTheyHaveHere) {
       << in_section[0];
 }
 
+// dynparam shows `target_points`; the parameter is `~selection/target_points`. A private
+// parameter set under a reconfigure name or a key without its section is read by nothing (and
+// the reconfigure server starts from the sectioned one): it is warned about, naming the
+// parameter. One whose value is the one in use is the server's own (it writes its names into
+// the private namespace) and is not.
+TEST(RosParams, ASectionlessNameIsWarnedAboutNamingItsSection) {
+  acvo::Params in_use;
+  in_use.selection.target_points = 3000;
+  XmlRpc::XmlRpcValue ns;
+  ns["target_points"] = 999;          // reconfigure name, another value: the trap
+  ns["max_depth"] = in_use.selection.max_depth;  // reconfigure name, the value in use
+  ns["paper_ell_init"] = 0.5;         // the paper engine's reconfigure name
+  ns["threads"] = 2;                  // a key without its section, not reconfigurable
+  ns["ell_min"] = std::string("x");   // two sections have it; reconfigure name of one
+  ns["engine"] = std::string(acvo::toString(in_use.registration.engine));  // the server's
+  ns["selection"] = section("target_points", 3000);
+  ns["base_frame_id"] = std::string("base_link");  // a nodelet setting: not this check's
+  const std::vector<std::string> problems = sectionlessParameters(ns, in_use);
+  std::string all;
+  for (const auto& s : problems) all += s + "\n";
+  ASSERT_EQ(problems.size(), 4u) << all;
+  EXPECT_NE(all.find("~ell_min = 'x' is not read (ignored): the parameter is "
+                     "~coarse_to_fine/ell_min or ~paper/ell_min; dynamic_reconfigure shows "
+                     "~coarse_to_fine/ell_min as ell_min"),
+            std::string::npos)
+      << all;
+  EXPECT_NE(all.find("~paper_ell_init = 0.5 is not read (ignored): the parameter is "
+                     "~paper/ell_init; dynamic_reconfigure shows ~paper/ell_init as "
+                     "paper_ell_init and starts it from ~paper/ell_init, not from "
+                     "~paper_ell_init\n"),
+            std::string::npos)
+      << all;
+  EXPECT_NE(all.find("~target_points = 999 is not read (ignored): the parameter is "
+                     "~selection/target_points; dynamic_reconfigure shows"),
+            std::string::npos)
+      << all;
+  EXPECT_NE(all.find("~threads = 2 is not read (ignored): the parameter is ~odometry/threads\n"),
+            std::string::npos)
+      << all;
+  // None of them is unknown to the check of the top-level names.
+  const std::vector<std::string> unknown = unknownParameters(ns, sectionlessNames());
+  EXPECT_TRUE(unknown.empty()) << unknown.front();
+}
+
 TEST(RosParams, ReconfigureRoundTripsAndDescribesEveryParameter) {
   acvo::Params p;
   p.selection.target_points = 777;

@@ -1567,10 +1567,11 @@ TEST(OdometryNodelet, ABinnedStreamIsMeasuredWithItsProjectionMatrix) {
 }
 
 // The .test sets a valid selection/target_points (1200: 600 at 320x240), an invalid
-// coarse_to_fine/ell_min (-1) and an unknown frame_id. The bad value alone is rejected (before,
-// one bad value put every parameter back to its default: 1500 points from test_params.yaml's
-// would have been lost too); the unknown name is reported with the name it has here. Both stay
-// in diagnostics.
+// coarse_to_fine/ell_min (-1), an unknown frame_id and max_depth, dynparam's name of
+// selection/max_depth, which nothing reads. The bad value alone is rejected (before, one bad
+// value put every parameter back to its default: 1500 points from test_params.yaml's would have
+// been lost too); the unknown name is reported with the name it has here, max_depth with its
+// section. All stay in diagnostics.
 TEST(OdometryNodelet, ABadParameterIsRejectedAloneAndAnUnknownOneIsNamed) {
   if (!client->bad_params_) GTEST_SKIP() << "needs nodelet_inputs.test";
   ASSERT_TRUE(client->reset());
@@ -1584,6 +1585,10 @@ TEST(OdometryNodelet, ABadParameterIsRejectedAloneAndAnUnknownOneIsNamed) {
   EXPECT_NE(problems->find("~coarse_to_fine/ell_min rejected"), std::string::npos) << *problems;
   EXPECT_NE(problems->find("~frame_id"), std::string::npos) << *problems;
   EXPECT_NE(problems->find("base_frame_id"), std::string::npos) << *problems;
+  EXPECT_NE(problems->find("~max_depth = 4.5 is not read (ignored): the parameter is "
+                           "~selection/max_depth"),
+            std::string::npos)
+      << *problems;
   EXPECT_EQ(problems->find("target_points"), std::string::npos) << *problems;
 }
 
