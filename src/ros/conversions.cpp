@@ -1,6 +1,7 @@
 #include "conversions.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <sstream>
@@ -235,6 +236,27 @@ std::string describeCamera(const acvo::Camera& camera, const IntrinsicsOverride&
 bool distortedCameraInfo(const sensor_msgs::CameraInfo& info, const IntrinsicsOverride& source) {
   return source.fromCameraInfo() &&
          std::any_of(info.D.begin(), info.D.end(), [](double d) { return d != 0.0; });
+}
+
+bool rectifiedTopic(const std::string& topic) {
+  const std::size_t slash = topic.rfind('/');
+  const std::string name = slash == std::string::npos ? topic : topic.substr(slash + 1);
+  // "rect" at the start of a word (image_rect, rect_color), not inside one ("direct").
+  for (std::size_t at = name.find("rect"); at != std::string::npos; at = name.find("rect", at + 1)) {
+    if (at == 0 || !std::isalpha(static_cast<unsigned char>(name[at - 1]))) return true;
+  }
+  return false;
+}
+
+std::string unrectifiedWarning(const sensor_msgs::CameraInfo& info,
+                               const IntrinsicsOverride& source, const InputTopics& topics) {
+  if (!distortedCameraInfo(info, source) || rectifiedTopic(topics.rgb)) return {};
+  return "camera_info on " + topics.info + " has a non-zero distortion (D) and the colour topic " +
+         topics.rgb +
+         " is not a rectified one (its name holds no \"rect\"): the images are used as if "
+         "rectified, so a distorted camera's points are off towards the image's edges. Subscribe "
+         "to the rectified images (image_proc's image_rect_color, a driver's rectified topic); "
+         "images rectified under another name are right as they are";
 }
 
 bool nominalCameraInfo(const sensor_msgs::CameraInfo& info, const IntrinsicsOverride& source) {

@@ -86,6 +86,14 @@ std::string describeCamera(const acvo::Camera& camera, const IntrinsicsOverride&
 // Whether the intrinsics in use are camera_info's and its D has a non-zero coefficient (the
 // images are then used as if rectified).
 bool distortedCameraInfo(const sensor_msgs::CameraInfo& info, const IntrinsicsOverride& source);
+// Whether a topic is, by its name, a rectified image: its last name holds a word starting with
+// "rect" (image_proc's image_rect and image_rect_color, a driver's image_rect_raw).
+bool rectifiedTopic(const std::string& topic);
+// The warning for images that may be distorted: camera_info's D in use is not zero and the
+// colour topic is not a rectified one (rectifiedTopic); "" otherwise. Drivers publish the
+// calibration's D with their rectified images too, so D alone says nothing.
+std::string unrectifiedWarning(const sensor_msgs::CameraInfo& info,
+                               const IntrinsicsOverride& source, const InputTopics& topics);
 // Whether the intrinsics in use are camera_info's and nominal rather than a calibration
 // (acvo::nominalIntrinsics, with camera_info's D all zero): a driver's or a dataset's defaults.
 // Judged at camera_info's full resolution (its P or K and width x height), so a binned stream

@@ -357,9 +357,9 @@ void OdometryNodelet::processFrame(const Image& rgb, const Image& depth, const I
     NODELET_WARN_ONCE("%s is mono8: points get intensity and gradient labels but no colour",
                       topics_.rgb.c_str());
   }
-  if (distortedCameraInfo(info, settings_.intrinsics)) {
-    NODELET_WARN_ONCE("%s has non-zero distortion: the images are used as if rectified",
-                      topics_.info.c_str());
+  if (const std::string warning = unrectifiedWarning(info, settings_.intrinsics, topics_);
+      !warning.empty()) {
+    NODELET_WARN_ONCE("%s", warning.c_str());
   }
   noteCamera(frame.camera, info);
   const std::string depth_frame = stripSlash(depth.header.frame_id);

@@ -304,6 +304,32 @@ TEST(DescribeCamera, SaysTheIntrinsicsTheirSourceAndWhetherTheyAreNominal) {
   EXPECT_FALSE(nominalCameraInfo(nominal, values));
 }
 
+// Drivers publish the calibration's D with their rectified images too: a non-zero D is warned
+// about only where the colour topic is not a rectified one by its name, and the warning says how
+// to tell.
+TEST(DescribeCamera, DistortionIsWarnedAboutOnlyOnAnUnrectifiedTopic) {
+  sensor_msgs::CameraInfo distorted = info(585, 585, 320, 240, 640, 480);
+  distorted.D = {0.1, -0.2, 0, 0, 0.05};
+  const InputTopics raw{"/camera/color/image_raw", "/d", "/camera/color/camera_info"};
+  const std::string warning = unrectifiedWarning(distorted, {}, raw);
+  EXPECT_NE(warning.find("/camera/color/camera_info"), std::string::npos) << warning;
+  EXPECT_NE(warning.find("/camera/color/image_raw is not a rectified one"), std::string::npos)
+      << warning;
+  EXPECT_NE(warning.find("\"rect\""), std::string::npos) << warning;
+  EXPECT_NE(warning.find("image_rect_color"), std::string::npos) << warning;
+  for (const char* rectified : {"/camera/rgb/image_rect_color", "/camera/rgb/image_rect",
+                                "image_rect_raw"}) {
+    EXPECT_EQ(unrectifiedWarning(distorted, {}, {rectified, "/d", "/i"}), "") << rectified;
+  }
+  // "rect" in a namespace is not the image's name (nor "direct" one's).
+  EXPECT_NE(unrectifiedWarning(distorted, {}, {"/rect/image_raw", "/d", "/i"}), "");
+  EXPECT_NE(unrectifiedWarning(distorted, {}, {"/camera/direct", "/d", "/i"}), "");
+  EXPECT_EQ(unrectifiedWarning(info(585, 585, 320, 240, 640, 480), {}, raw), "") << "D all zero";
+  IntrinsicsOverride named;
+  named.camera = "fr1";
+  EXPECT_EQ(unrectifiedWarning(distorted, named, raw), "") << "camera_info's D not in use";
+}
+
 Eigen::Isometry3d pose(double rx, double ry, double rz, double x, double y, double z) {
   Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
   t.linear() = (Eigen::AngleAxisd(rz, Eigen::Vector3d::UnitZ()) *
