@@ -1443,7 +1443,7 @@ TEST(OdometryNodelet, PauseDropsFramesAndResumeGoesOn) {
                  "3 frames after a pause of 2 frames");
 }
 
-// A camera four times faster than the odometry (a slow machine, a slow frame): the subscriber
+// A camera six times faster than the odometry (a slow machine, a slow frame): the subscriber
 // queues (topic_queue_size 2) keep the newest frames and drop the older ones, so that the
 // latency stays a few frames' processing instead of growing with a backlog, as it did when the
 // subscriber queues were the synchroniser's 10. Stamps are the wall clock's here, so that
