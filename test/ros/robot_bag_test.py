@@ -15,7 +15,12 @@ Run by rostest with the parameter `robot_bag_case` (the .test sets it, use_sim_t
              one; with none in TF. The exact guess needs fewer iterations; the biased one gives
              the same accuracy; TF chains vo -> odom -> base_link; without the wheels the
              prior is used, said (throttled), and no frame waits for them.
+  loop       acvo.launch with initial_pose (the parameter /robot_bag_initial_pose, "x y z roll
+             pitch yaw") on the bag played with --loop: each time the bag starts again the
+             simulated clock steps back, and the odometry starts over at initial_pose, as the
+             first time, with a warning that says so; each pass tracks as the first did.
 """
+import math
 import os
 import signal
 import subprocess
@@ -66,6 +71,20 @@ def executable(name):
     return paths[0]
 
 
+def check_bound(test, what, figure, bound, unit):
+    """figure < bound, printed as scripts/measure_ros_bounds reads it."""
+    print("[ BOUND ] %s: %.6g %s (bound < %.6g)" % (what, figure, unit, bound))
+    test.assertLess(figure, bound, what)
+
+
+def check_timing(test, what, figure, bound, unit, catches):
+    """figure < bound, a bound that is no multiple of a measurement: `catches` says what it
+    is there for; printed as scripts/measure_ros_bounds reads it."""
+    print("[ TIMING ] %s: %.6g %s (bound < %.6g; catches %s)" % (what, figure, unit, bound,
+                                                                  catches))
+    test.assertLess(figure, bound, what)
+
+
 def rotation_angle(r):
     return float(np.arccos(np.clip((np.trace(r) - 1) / 2, -1.0, 1.0)))
 
@@ -97,6 +116,7 @@ class Recorder:
     def __init__(self, namespace):
         self.lock = threading.Lock()
         self.odom, self.info, self.parents, self.tf = {}, {}, {}, {}
+        self.info_seq, self.odom_seq = [], []  # in the order received (a looped bag repeats)
         self.warnings = []
         self.last = time.monotonic()
         self.subs = [
@@ -114,11 +134,13 @@ class Recorder:
     def on_odom(self, msg):
         with self.lock:
             self.odom[msg.header.stamp.to_nsec()] = msg
+            self.odom_seq.append(msg)
             self.last = time.monotonic()
 
     def on_info(self, msg):
         with self.lock:
             self.info[msg.header.stamp.to_nsec()] = msg
+            self.info_seq.append(msg)
             self.last = time.monotonic()
 
     def on_log(self, msg):
@@ -139,6 +161,28 @@ class Recorder:
                 if time.monotonic() - self.last > idle:
                     return
             time.sleep(0.1)
+
+
+def pose6_matrix(text):
+    """The 4x4 pose of "x y z roll pitch yaw" (R = Rz(yaw) Ry(pitch) Rx(roll)), as initial_pose."""
+    x, y, z, roll, pitch, yaw = (float(v) for v in text.split())
+    cr, sr, cp, sp, cy, sy = (math.cos(roll), math.sin(roll), math.cos(pitch), math.sin(pitch),
+                              math.cos(yaw), math.sin(yaw))
+    m = np.eye(4)
+    m[:3, :3] = np.array([[cy, -sy, 0], [sy, cy, 0], [0, 0, 1]]) @ np.array(
+        [[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]]) @ np.array([[1, 0, 0], [0, cr, -sr], [0, sr, cr]])
+    m[:3, 3] = [x, y, z]
+    return m
+
+
+def passes(messages):
+    """Messages in the order received, split where the stamps go back (a looped bag)."""
+    out = []
+    for m in messages:
+        if not out or m.header.stamp < out[-1][-1].header.stamp:
+            out.append([])
+        out[-1].append(m)
+    return out
 
 
 def wait_for_subscribers(topic, limit=60.0):
@@ -305,8 +349,67 @@ class RobotBagTest(unittest.TestCase):
                              "freenect.launch")
         elif case == "guess":
             self.guess_case()
+        elif case == "loop":
+            self.loop_case()
         else:
             self.fail("unknown case %s" % case)
+
+    def loop_case(self):
+        """The bag looped under --clock: every pass starts at initial_pose and tracks."""
+        bag = self.make_bag("freenect")
+        initial = pose6_matrix(rospy.get_param("/robot_bag_initial_pose"))
+        recorder = Recorder("")  # loop_bag.test includes acvo.launch in the root namespace
+        d = robot_bag.DRIVERS["freenect"]
+        pass_seconds = FRAMES / RATE_HZ / PLAY_RATE
+        try:
+            self.assertTrue(wait_for_subscribers(d["rgb"]),
+                            "the nodelet did not subscribe to the driver's colour topic")
+            player = subprocess.Popen(
+                ["rosbag", "play", bag, "--clock", "--hz=1000", "--quiet", "--delay=1", "--loop",
+                 "--rate=%g" % PLAY_RATE, "--topics", d["rgb"], d["depth"], d["info"],
+                 "/tf_static"], stdout=subprocess.DEVNULL, stderr=subprocess.STDOUT)
+            try:
+                # Until the third pass begins: the second one is then complete.
+                deadline = time.monotonic() + 1.0 + 4 * pass_seconds + 60.0
+                while time.monotonic() < deadline:
+                    with recorder.lock:
+                        if len(passes(recorder.info_seq)) >= 3:
+                            break
+                    time.sleep(0.1)
+            finally:
+                player.send_signal(signal.SIGINT)
+                player.wait(timeout=30)
+            time.sleep(1.0)
+        finally:
+            recorder.close()
+        with recorder.lock:
+            info_passes = passes(recorder.info_seq)[:2]
+            odom_passes = passes(recorder.odom_seq)[:2]
+            warnings = list(recorder.warnings)
+        self.assertEqual(len(info_passes), 2, "the bag did not play twice")
+        self.assertEqual(len(odom_passes), 2)
+        said = [w for w in warnings if "on the simulated clock" in w]
+        print("[ MEASURED ] loop: frames processed per pass %s; warnings %s" % (
+            [len(p) for p in info_passes], said))
+        self.assertTrue(any("odometry restarts at initial_pose" in w for w in said), warnings)
+        for k, (infos, odoms) in enumerate(zip(info_passes, odom_passes)):
+            name = "pass %d" % (k + 1)
+            self.assertGreaterEqual(len(infos), MIN_PUBLISHED * FRAMES, name)
+            self.assertEqual(infos[0].tracking, "first_frame", name)
+            self.assertTrue(all(i.tracking in ("ok", "hard") for i in infos[1:]),
+                            "%s: %s" % (name, [(i.tracking, i.message) for i in infos]))
+            self.assertEqual(odoms[0].header.stamp, infos[0].header.stamp, name)
+            start_error = np.abs(pose_matrix(odoms[0].pose.pose) - initial).max()
+            estimate = {m.header.stamp.to_nsec(): pose_matrix(m.pose.pose) for m in odoms}
+            stamps = sorted(s for s in estimate if s in self.truth)
+            worst_t, worst_r = worst_relative_error(estimate, self.truth, stamps)
+            print("[ MEASURED ] loop, %s: first frame at %.6f s, %.1e off initial_pose" % (
+                name, infos[0].header.stamp.to_sec(), start_error))
+            self.assertLess(start_error, 1e-6, "%s does not start at initial_pose" % name)
+            check_bound(self, "robot bag, worst base pose error relative to the first frame, "
+                        "translation", worst_t, TRANSLATION_TOLERANCE, "m")
+            check_bound(self, "robot bag, worst base pose error relative to the first frame, "
+                        "rotation", worst_r, ROTATION_TOLERANCE, "rad")
 
     def guess_case(self):
         bag = self.make_bag("freenect")
