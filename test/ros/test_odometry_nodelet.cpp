@@ -51,20 +51,26 @@ namespace {
 using acvo_test::cameraPose;
 using acvo_test::RgbdImage;
 
-// What each pose check allows: kMargin times the error measured at that check (the larger over
-// the .test configurations that run it; acvo_synthetic room at 320x240, 1500 points, 1.5 cm and
-// 0.6 deg of motion per frame, exact depth; measured 2026-11-26 from the `[ MEASURED ]` lines of
-// four `scripts/test` runs, which agreed to 3 digits: the frames' scheduling does not move
-// them), so that a regression of the engine or of the nodelet fails it. The 16-bit
-// configuration's millimetre depth steps set most of them (0.04-0.2 mm; the float one's errors
-// are 1-5 micrometres). Poses that must be exact (the
-// origin, a held pose) use kExactPose.
+// What each check of a measured figure allows: kMargin times the figure measured at that check,
+// the largest over the .test configurations that run it (acvo_synthetic room at 320x240, 1500
+// points, 1.5 cm and 0.6 deg of motion per frame, exact depth), so that a regression of the
+// engine or of the nodelet fails it. The figures (the `Measured{}` and `k...Measured` values
+// below) are what scripts/measure_ros_bounds printed: it runs the .test files and sets each
+// `[ BOUND ]` line's figure, the largest over the configurations, beside its bound. The 16-bit
+// configuration's millimetre depth steps set most of them; the float one's errors are smaller.
+// Poses that must be exact (the origin, a held pose) use kExactPose. Timing checks (`[ TIMING ]`)
+// are no multiple of a measurement: each says what it catches.
 struct Measured {
   double t = 0.0;  // m
   double r = 0.0;  // rad
 };
 constexpr double kMargin = 2.5;
 constexpr Measured kExactPose{};
+// Figures of checks that are not a pose's (scripts/measure_ros_bounds).
+constexpr double kTwistMeasured = 0.000396;            // m/s
+constexpr double kAfterInvalidMeasured = 0.0000174;     // m
+constexpr Measured kAfterBlackoutMeasured{0.0000248, 0.00000884};
+constexpr double kTwistAfterNoiseMeasured = 0.00107;    // m/s
 constexpr int kTrackFrames = 12;
 constexpr double kExact = 1e-9;
 constexpr double kOutcomeTimeout = 20.0;  // s, one frame through a loaded machine
@@ -534,18 +540,42 @@ std::vector<int> range(int from, int to) {
   return v;
 }
 
+// A figure within kMargin of what was measured there (`measured`): fails otherwise, and prints
+// "[ BOUND ] what: figure unit (bound < B)" for scripts/measure_ros_bounds.
+void expectMeasured(const std::string& what, double figure, double measured, const char* unit) {
+  const double bound = kMargin * measured;
+  EXPECT_LT(figure, bound) << what << ": " << figure << " " << unit;
+  std::cout << "[ BOUND ] " << what << ": " << figure << " " << unit << " (bound < " << bound
+            << ")\n";
+}
+
+// A timing figure (or a count of frames that a backlog would raise) against a bound that is no
+// multiple of a measurement: `catches` says what it is there to catch. Printed as "[ TIMING ]
+// what: figure unit (bound OP B; catches ...)" for scripts/measure_ros_bounds.
+void expectTiming(const std::string& what, double figure, const char* op, double bound,
+                  const char* unit, const std::string& catches) {
+  const bool within = std::string(op) == "<=" ? figure <= bound : figure < bound;
+  EXPECT_TRUE(within) << what << ": " << figure << " " << unit << ", bound " << op << " " << bound
+                      << " (catches " << catches << ")";
+  std::cout << "[ TIMING ] " << what << ": " << figure << " " << unit << " (bound " << op << " "
+            << bound << "; catches " << catches << ")\n";
+}
+
 // Within kMargin of what was measured there (`measured`), or exact (kExactPose).
 void expectPoseNear(const geometry_msgs::Pose& got, const Eigen::Isometry3d& want,
                     const Measured& measured, const std::string& what) {
   const Eigen::Isometry3d g = toEigen(got);
   const double dt = (g.translation() - want.translation()).norm();
   const double dr = angleOf(g.rotation().transpose() * want.rotation());
-  const double max_t = measured.t > 0.0 ? kMargin * measured.t : kExact;
-  const double max_r = measured.r > 0.0 ? kMargin * measured.r : kExact;
-  EXPECT_LT(dt, max_t) << what << ": translation error " << dt << " m";
-  EXPECT_LT(dr, max_r) << what << ": rotation error " << dr << " rad";
-  std::cout << "[ MEASURED ] " << what << ": translation error " << dt << " m, rotation error "
-            << dr << " rad (measured before: " << measured.t << " m, " << measured.r << " rad)\n";
+  if (measured.t > 0.0) {
+    expectMeasured(what + ", translation error", dt, measured.t, "m");
+    expectMeasured(what + ", rotation error", dr, measured.r, "rad");
+    return;
+  }
+  EXPECT_LT(dt, kExact) << what << ": translation error " << dt << " m";
+  EXPECT_LT(dr, kExact) << what << ": rotation error " << dr << " rad";
+  std::cout << "[ MEASURED ] " << what << " (exact): translation error " << dt
+            << " m, rotation error " << dr << " rad\n";
 }
 
 // Runs first (gtest keeps the order of definition): before any frame, the camera frame and its
@@ -565,7 +595,7 @@ TEST(OdometryNodelet, AResetToPoseBeforeTheFirstFrameIsWhereItStarts) {
   ASSERT_TRUE(out[0].odom && out.back().odom);
   EXPECT_EQ(out[0].info->tracking, "first_frame");
   expectPoseNear(out[0].odom->pose.pose, given, kExactPose, "first frame after an early reset_odom_to_pose");
-  expectPoseNear(out.back().odom->pose.pose, given * client->expectedBase(cameraPose(3)), Measured{0.0000769, 0.0000472},
+  expectPoseNear(out.back().odom->pose.pose, given * client->expectedBase(cameraPose(3)), Measured{0.0000216, 0.00000697},
                  "3 frames after an early reset_odom_to_pose");
 }
 
@@ -578,7 +608,7 @@ TEST(OdometryNodelet, StartsAtTheInitialPose) {
   EXPECT_EQ(out[0].info->tracking, "first_frame");
   expectPoseNear(out[0].odom->pose.pose, *client->initial_pose_, kExactPose, "first frame, initial_pose");
   expectPoseNear(out.back().odom->pose.pose,
-                 *client->initial_pose_ * client->expectedBase(cameraPose(3)), Measured{0.00000378, 0.00000643},
+                 *client->initial_pose_ * client->expectedBase(cameraPose(3)), Measured{0.00000345, 0.00000606},
                  "3 frames after initial_pose");
   const auto tf = client->lookup(out.back().odom->header.stamp);
   ASSERT_TRUE(tf);
@@ -597,6 +627,7 @@ TEST(OdometryNodelet, TracksKnownMotionWithRightFramesCovarianceAndTf) {
   ASSERT_EQ(out.size(), static_cast<std::size_t>(kTrackFrames));
   double keyframe_variance = 0.0;  // the pose variance of the keyframe in use
   int keyframes = 0;
+  double worst_twist = 0.0;  // m/s off the true velocity
   for (int k = 0; k < kTrackFrames; ++k) {
     SCOPED_TRACE("frame " + std::to_string(k));
     ASSERT_TRUE(out[k].info) << "no odom_info";
@@ -631,12 +662,11 @@ TEST(OdometryNodelet, TracksKnownMotionWithRightFramesCovarianceAndTf) {
       EXPECT_LT(variance, acvo_ros::kLostVariance);
       for (int d = 0; d < 6; ++d) EXPECT_GT(odom.twist.covariance[7 * d], 0.0);
       // Twist: the base-frame motion of one frame over 0.1 s. One registration is less exact
-      // than the drift per frame suggests (errors partly cancel along the path): measured up to
-      // 0.050 m/s (5 mm in a frame, the first one, which has no motion prior).
+      // than the drift per frame suggests (errors partly cancel along the path).
       const Eigen::Isometry3d step = client->expectedBase(acvo_test::frameMotion());
       Eigen::Vector3d v(odom.twist.twist.linear.x, odom.twist.twist.linear.y,
                         odom.twist.twist.linear.z);
-      EXPECT_LT((v - step.translation() / 0.1).norm(), 0.1) << "m/s";
+      worst_twist = std::max(worst_twist, (v - step.translation() / 0.1).norm());
     }
     if (info.new_keyframe) {
       keyframe_variance = variance;
@@ -644,7 +674,9 @@ TEST(OdometryNodelet, TracksKnownMotionWithRightFramesCovarianceAndTf) {
     }
   }
   EXPECT_GT(keyframes, 1) << "the camera moves on: the keyframe changes";
-  expectPoseNear(out.back().odom->pose.pose, client->expectedBase(cameraPose(kTrackFrames - 1)), Measured{0.000163, 0.0000640}, "final pose");
+  expectMeasured("twist of a tracked frame, worst off the true velocity", worst_twist,
+                 kTwistMeasured, "m/s");
+  expectPoseNear(out.back().odom->pose.pose, client->expectedBase(cameraPose(kTrackFrames - 1)), Measured{0.0000284, 0.0000214}, "final pose");
 
   const auto tf = client->lookup(stamps.back());
   ASSERT_TRUE(tf) << client->odom_frame_ << " -> " << client->base_frame_ << " not in TF";
@@ -738,7 +770,7 @@ TEST(OdometryNodelet, ResetReturnsToIdentityAndToAGivenPose) {
   EXPECT_EQ(out[0].info->tracking, "first_frame");
   expectPoseNear(out[0].odom->pose.pose, Eigen::Isometry3d::Identity(), kExactPose, "after reset_odom");
   expectPoseNear(out.back().odom->pose.pose,
-                 client->expectedBase(cameraPose(4).inverse() * cameraPose(7)), Measured{0.0000413, 0.0000196},
+                 client->expectedBase(cameraPose(4).inverse() * cameraPose(7)), Measured{0.0000103, 0.00000903},
                  "3 frames after reset_odom");
 
   Eigen::Isometry3d given = Eigen::Isometry3d::Identity();
@@ -751,7 +783,7 @@ TEST(OdometryNodelet, ResetReturnsToIdentityAndToAGivenPose) {
   ASSERT_TRUE(out[0].odom && out.back().odom);
   expectPoseNear(out[0].odom->pose.pose, given, kExactPose, "after reset_odom_to_pose");
   expectPoseNear(out.back().odom->pose.pose,
-                 given * client->expectedBase(cameraPose(8).inverse() * cameraPose(11)), Measured{0.000112, 0.0000390},
+                 given * client->expectedBase(cameraPose(8).inverse() * cameraPose(11)), Measured{0.0000117, 0.0000106},
                  "3 frames after reset_odom_to_pose");
 
   geometry_msgs::Pose bad;  // zero quaternion
@@ -817,8 +849,8 @@ TEST(OdometryNodelet, InvalidFramesAreLostThenTrackingResumes) {
       toEigen(again[0].odom->pose.pose).inverse() * toEigen(again.back().odom->pose.pose);
   const Eigen::Isometry3d want = client->expectedBase(cameraPose(5).inverse() * cameraPose(8));
   const double since_t = (since.translation() - want.translation()).norm();
-  std::cout << "[ MEASURED ] 3 frames after invalid ones: translation error " << since_t << " m\n";
-  EXPECT_LT(since_t, kMargin * 0.0000909);  // measured 0.091 mm (16UC1), 0.0068 mm (32FC1)
+  expectMeasured("3 frames after invalid ones, translation error", since_t,
+                 kAfterInvalidMeasured, "m");
   const auto [level, message] = diagnosticFor(again.back().info->tracking);
   const auto ok = client->waitDiagnostic(level, message);
   ASSERT_TRUE(ok);
@@ -857,7 +889,7 @@ TEST(OdometryNodelet, EveryOtherFrameMissingIsTrackedAndEveryFrameIsPublished) {
         << out[i].info->tracking << ": " << out[i].info->message;
   }
   // The budget is per frame of motion (12 frames' worth in 6 registrations).
-  expectPoseNear(out.back().odom->pose.pose, client->expectedBase(cameraPose(kLast)), Measured{0.000215, 0.0000680},
+  expectPoseNear(out.back().odom->pose.pose, client->expectedBase(cameraPose(kLast)), Measured{0.0000136, 0.0000194},
                  "every other frame missing, final pose");
 }
 
@@ -929,14 +961,16 @@ TEST(OdometryNodelet, BlackoutOfBlankFramesIsLostNamedThenTrackingResumes) {
   std::cout << "[ MEASURED ] blackout: resumed at frame " << resumed << "; from there to frame "
             << last << ": translation error " << since_t << " m, rotation error " << since_r
             << " rad\n";
-  EXPECT_LT(since_t, kMargin * 0.000173);  // measured 0.172 mm (16UC1), 0.011 mm (32FC1)
-  EXPECT_LT(since_r, kMargin * 0.0000935);  // measured 0.093 mrad, 0.0075 mrad
-  // No jump on recovery (REP 105: odom is continuous), not by the 18 cm the camera travelled
-  // unseen: where the frame after the blackout was lost and became the reference, the frame that
-  // tracks again moves the published pose by one frame's motion from the held pose; where it
-  // registered again against the last frame before the blackout (the 32FC1 camera: the 0.169 m
-  // unseen found to a few micrometres), the published pose goes on from the held one, as dead
-  // reckoning without a guess has it (ContinuousOdom).
+  expectMeasured("blackout, from resumption on, translation error", since_t,
+                 kAfterBlackoutMeasured.t, "m");
+  expectMeasured("blackout, from resumption on, rotation error", since_r,
+                 kAfterBlackoutMeasured.r, "rad");
+  // No jump on recovery (REP 105: odom is continuous), not by the 17 cm the camera travelled
+  // unseen: where the frame after the blackout registers again against the last frame before it
+  // (both configurations today: the unseen motion found to micrometres), the published pose goes
+  // on from the held one exactly, as dead reckoning without a guess has it (ContinuousOdom);
+  // where that frame was lost and became the reference (the 16-bit camera before the direct
+  // terms), the frame that tracks again moves the published pose by one frame's motion.
   const bool bridged = resumed == kBefore + kBlank;
   const Eigen::Isometry3d step = toEigen(out[resumed - 1].odom->pose.pose).inverse() *
                                  toEigen(out[resumed].odom->pose.pose);
@@ -948,8 +982,15 @@ TEST(OdometryNodelet, BlackoutOfBlankFramesIsLostNamedThenTrackingResumes) {
             << step.translation().norm() << " m, " << step_t << " m off "
             << (bridged ? "the held pose" : "one frame's motion") << ", " << step_r << " rad\n";
   EXPECT_TRUE(toEigen(out[resumed - 1].odom->pose.pose).isApprox(toEigen(held), kExact));
-  EXPECT_LT(step_t, kMargin * 0.000134);  // measured 0.134 mm, 16UC1 (the jump was 18 cm)
-  EXPECT_LT(step_r, kMargin * 0.0000780);  // measured 0.078 mrad, 16UC1
+  if (bridged) {
+    EXPECT_LT(step_t, kExact) << "the recovery moved the published pose";
+    EXPECT_LT(step_r, kExact) << "the recovery turned the published pose";
+  } else {
+    // No configuration takes this branch today: its figures are those measured when the 16-bit
+    // one did (0.134 mm, 0.078 mrad), at the drift of the frames after it.
+    EXPECT_LT(step_t, kMargin * kAfterBlackoutMeasured.t + 0.000134) << "m";
+    EXPECT_LT(step_r, kMargin * kAfterBlackoutMeasured.r + 0.000078) << "rad";
+  }
   // Across the blackout: the motion during it is not observed (the pose is held while lost,
   // and the recovery does not jump); the error is that motion plus the registered frames'
   // drift.
@@ -960,8 +1001,8 @@ TEST(OdometryNodelet, BlackoutOfBlankFramesIsLostNamedThenTrackingResumes) {
   std::cout << "[ MEASURED ] blackout: error from frame " << kBefore - 1 << " to " << last << ": "
             << across_t << " m (motion from the last good frame to resumption "
             << unseen.translation().norm() << " m)\n";
-  // The registered frames' drift as measured from resumption (0.172 mm, above).
-  EXPECT_LT(across_t, unseen.translation().norm() + kMargin * 0.000173);
+  // The registered frames' drift as measured from resumption (above).
+  EXPECT_LT(across_t, unseen.translation().norm() + kMargin * kAfterBlackoutMeasured.t);
 }
 
 // The same blackout with wheel odometry on TF (guess_frame_id): while lost, the base follows
@@ -992,7 +1033,7 @@ TEST(OdometryNodelet, WithAGuessTheBlackoutFollowsTheWheelsAndRecoversWithoutAJu
     EXPECT_TRUE(out[k].info->guess_from_tf);
     // Dead-reckoned on the wheels from the last tracked frame: off by that frame's drift only.
     const Eigen::Isometry3d want = origin.inverse() * wheels[k];
-    expectPoseNear(out[k].odom->pose.pose, want, Measured{0.00000377, 0.00000643}, "lost, on the wheels");
+    expectPoseNear(out[k].odom->pose.pose, want, Measured{0.000000849, 0.00000181}, "lost, on the wheels");
     const auto tf = client->lookup(stamps[k]);
     ASSERT_TRUE(tf) << "no TF odom -> base through the wheels while lost";
     EXPECT_TRUE(tf2::transformToEigen(*tf).isApprox(toEigen(out[k].odom->pose.pose), 1e-6));
@@ -1006,11 +1047,12 @@ TEST(OdometryNodelet, WithAGuessTheBlackoutFollowsTheWheelsAndRecoversWithoutAJu
   const Eigen::Isometry3d true_step = wheels[resumed - 1].inverse() * wheels[resumed];
   std::cout << "[ MEASURED ] blackout with a guess: recovery step off the true one by "
             << (step.translation() - true_step.translation()).norm() << " m\n";
-  // Measured: the guess's own step to the digit (the recovery continues from the wheels).
+  // The guess's own step, exactly but for rounding (the recovery continues from the wheels:
+  // 7e-17 m measured).
   EXPECT_LT((step.translation() - true_step.translation()).norm(), 1e-6);
   // And the whole run is where the wheels say: nothing of the blackout's motion is lost.
   const int last = int(out.size()) - 1;
-  expectPoseNear(out[last].odom->pose.pose, origin.inverse() * wheels[last], Measured{0.00000550, 0.00000671},
+  expectPoseNear(out[last].odom->pose.pose, origin.inverse() * wheels[last], Measured{0.00000362, 0.00000144},
                  "end of a blackout bridged by the wheels");
 }
 
@@ -1038,10 +1080,8 @@ TEST(OdometryNodelet, ASingleFrameOfNoiseIsLostAndTrackingResumes) {
   const Eigen::Isometry3d step = client->expectedBase(acvo_test::frameMotion());
   const auto& twist = out[4].odom->twist.twist.linear;
   const Eigen::Vector3d v(twist.x, twist.y, twist.z);
-  std::cout << "[ MEASURED ] twist after the noise frame: " << (v - step.translation() / 0.1).norm()
-            << " m/s off\n";
-  EXPECT_LT((v - step.translation() / 0.1).norm(), kMargin * 0.00153)
-      << "m/s (measured 1.52 mm/s with 16UC1 depth, 0.89 mm/s with 32FC1)";
+  expectMeasured("twist after the noise frame, off the true velocity",
+                 (v - step.translation() / 0.1).norm(), kTwistAfterNoiseMeasured, "m/s");
   EXPECT_TRUE(toEigen(out.back().odom->pose.pose).matrix().allFinite());
 }
 
@@ -1063,7 +1103,7 @@ TEST(OdometryNodelet, ALargeStampGapIsWarnedAndProcessingContinues) {
   ASSERT_TRUE(warning) << "no warning about the gap on /rosout";
   EXPECT_NE(warning->find("max_time_gap"), std::string::npos) << *warning;
   std::cout << "[ MEASURED ] gap warning: " << *warning << "\n";
-  expectPoseNear(after.back().odom->pose.pose, client->expectedBase(cameraPose(6)), Measured{0.000121, 0.0000591},
+  expectPoseNear(after.back().odom->pose.pose, client->expectedBase(cameraPose(6)), Measured{0.0000161, 0.0000143},
                  "3 frames after a 3 s gap");
 }
 
@@ -1140,7 +1180,7 @@ TEST(OdometryNodelet, BadInputIsNamedAndSkippedAndTheNodeCarriesOn) {
   const std::vector<Outcome> out = client->run(range(3, 6));
   ASSERT_TRUE(out.back().odom);
   EXPECT_TRUE(isTracking(out.back().info->tracking)) << out.back().info->message;
-  expectPoseNear(out.back().odom->pose.pose, client->expectedBase(cameraPose(5)), Measured{0.000122, 0.0000744},
+  expectPoseNear(out.back().odom->pose.pose, client->expectedBase(cameraPose(5)), Measured{0.0000253, 0.0000123},
                  "after bad frames");
 }
 
@@ -1439,7 +1479,7 @@ TEST(OdometryNodelet, PauseDropsFramesAndResumeGoesOn) {
   // The first frame sent while paused never comes out (the last one may: the approximate
   // synchroniser holds it until the next frame, sent after resume_odom).
   EXPECT_EQ(client->infoCount(paused.front()), 0);
-  expectPoseNear(after.back().odom->pose.pose, client->expectedBase(cameraPose(8)), Measured{0.000146, 0.000110},
+  expectPoseNear(after.back().odom->pose.pose, client->expectedBase(cameraPose(8)), Measured{0.0000486, 0.0000167},
                  "3 frames after a pause of 2 frames");
 }
 
@@ -1499,12 +1539,17 @@ TEST(OdometryNodelet, AFasterCameraIsDroppedNotQueued) {
             << " ms (one takes " << typical << " ms alone, up to " << slowest
             << " ms): " << latency.size() << " processed; latency first " << latency.front()
             << " ms, last " << latency.back() << " ms, worst " << worst << " ms\n";
-  // A backlog processes every frame it holds, each later than the one before. Measured: with
-  // the queues of 2, 9 of 30 processed, worst latency 110-123 ms (three runs, the camera at a
-  // quarter); with 10 per topic (as before) 16-21 processed and 455-475 ms. At a sixth
-  // (2026-11-26, five runs): 8 of 30, worst 58-88 ms.
-  EXPECT_LE(latency.size(), std::size_t{kFrames * 2 / 5});
-  EXPECT_LT(worst, kQueuedFrames * slowest + kLatencySlack);
+  // A backlog processes every frame it holds, each later than the one before: with 10 queued
+  // per topic (as before) 16-21 of 30 were processed and the latency grew to 455-475 ms. The
+  // figures of today's queues: scripts/measure_ros_bounds.
+  constexpr int kMostProcessed = kFrames * 2 / 5;
+  expectTiming("burst, frames processed of 30", double(latency.size()), "<=", kMostProcessed,
+               "frames", "a backlog, every frame processed in turn (16-21 of 30 with 10 queued "
+               "per topic)");
+  expectTiming("burst, worst latency", worst, "<", kQueuedFrames * slowest + kLatencySlack, "ms",
+               "a backlog: more than the frames the queues hold ahead of a new one, each a "
+               "slowest frame's processing, plus 100 ms of transport (475 ms with 10 queued "
+               "per topic)");
   EXPECT_TRUE(isTracking(last.info->tracking)) << last.info->message;
 }
 
@@ -1515,6 +1560,7 @@ TEST(OdometryNodelet, MissingBaseTransformIsReportedNotReplacedByIdentity) {
   // odom_info says why. The nodelet waits for the transform once (wait_for_transform_duration
   // 1 s in the .test), not at every frame: each wait blocked the callback queue.
   std::vector<Outcome> without = client->run(range(0, 4));
+  double slowest_after_first = 0.0;  // ms
   for (std::size_t k = 0; k < without.size(); ++k) {
     const Outcome& o = without[k];
     ASSERT_TRUE(o.info);
@@ -1523,11 +1569,13 @@ TEST(OdometryNodelet, MissingBaseTransformIsReportedNotReplacedByIdentity) {
         << o.info->message;
     std::cout << "[ MEASURED ] without the base transform, frame " << k << ": ms_total "
               << o.info->ms_total << "\n";
-    if (k > 0) {
-      // Measured: 1015 ms for the first frame (the one wait), 7 ms for the next.
-      EXPECT_LT(o.info->ms_total, 500.0) << "frame " << k << " waited for TF again";
-    }
+    if (k > 0) slowest_after_first = std::max(slowest_after_first, o.info->ms_total);
   }
+  // The first frame waits (1 s); the next ones must not.
+  expectTiming("without the base transform, slowest frame after the first", slowest_after_first,
+               "<", 500.0, "ms",
+               "a wait for the base transform at every frame (wait_for_transform_duration 1 s "
+               "in the .test)");
   // The transform appears: the next frames are published, conjugated by it, and continue the
   // motion measured meanwhile.
   tf2_ros::StaticTransformBroadcaster broadcaster;
@@ -1540,7 +1588,7 @@ TEST(OdometryNodelet, MissingBaseTransformIsReportedNotReplacedByIdentity) {
   std::vector<Outcome> with = client->run(range(4, 7));
   ASSERT_TRUE(with.back().odom);
   EXPECT_EQ(with.back().odom->child_frame_id, client->base_frame_);
-  expectPoseNear(with.back().odom->pose.pose, client->expectedBase(cameraPose(6)), Measured{0.0000102, 0.0000143},
+  expectPoseNear(with.back().odom->pose.pose, client->expectedBase(cameraPose(6)), Measured{0.00000464, 0.00000705},
                  "after the base transform arrived");
 }
 
@@ -1557,7 +1605,7 @@ TEST(OdometryNodelet, ABinnedStreamIsMeasuredWithItsProjectionMatrix) {
     ASSERT_TRUE(o.odom) << o.info->tracking << ": " << o.info->message;
   }
   EXPECT_TRUE(isTracking(out.back().info->tracking)) << out.back().info->message;
-  expectPoseNear(out.back().odom->pose.pose, client->expectedBase(cameraPose(6)), Measured{0.00000807, 0.00000718},
+  expectPoseNear(out.back().odom->pose.pose, client->expectedBase(cameraPose(6)), Measured{0.0000107, 0.0000104},
                  "binned stream, intrinsics from P");
   if (client->depth_frame_ != acvo_ros::stripSlash(client->camera_frame_)) {
     const auto warning = client->waitLog("frame_id '" + client->depth_frame_ + "' differs", since);
