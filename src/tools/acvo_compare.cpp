@@ -3,7 +3,8 @@
 // one table (and JSON).
 //
 // Fair by construction: the peers run as OpenCV's own TUM sample runs them (peers.hpp: NaN holes,
-// compute(current, previous)) at every maximum depth given, with the best setting named; acvo
+// compute(current, previous)) at every maximum depth given, with and without the last motion as
+// their initial guess, the best setting named; acvo
 // runs on as many threads as asked (one by default: the peers are serial) and its CPU time is
 // shown; every frame goes to every method in turn (the order rotating), so that a machine that
 // slows down or speeds up during the run does so for all of them; --repeat gives the median of
@@ -41,7 +42,8 @@ folders (rgb.txt, depth.txt, associations.txt, groundtruth.txt, camera.yaml) and
 table: RPE over 1 s (translation m/s, rotation deg/s), ATE (m), lost frames, median time per
 frame (wall and CPU) and the median time as a ratio of the best RgbdOdometry setting's.
 The OpenCV odometries run as OpenCV's TUM sample runs them (missing depth as NaN, the current
-frame registered to the previous one, no initial guess), once per --peer-max-depth; the
+frame registered to the previous one), once per --peer-max-depth and --peer-guess (none, as the
+sample; last, the last frame's motion as the initial guess, which helps them on fast turns); the
 <peer>_best row repeats the setting with the lowest errors (translation and rotation, each
 relative to the settings' mean). Every method sees the same decoded frames, frame by frame in
 turn; times cover the odometry call only (acvo: cloud building and registration; OpenCV: grey
@@ -66,7 +68,7 @@ struct Options {
   std::string config, label = "acvo", json, trajectories, camera;
   long frames = -1, stride = 1;
   int repeat = 1;
-  bool peer_guess = false;
+  std::vector<std::string> peer_guess{"none", "last"};
   std::optional<double> offset = 0.0;  // empty: estimated per dataset (--offset auto)
 };
 
@@ -100,9 +102,14 @@ std::optional<int> parseOptions(CLI::App& app, Options& o, int argc, char** argv
       ->type_name("N")
       ->capture_default_str()
       ->check(acvo::tools::numberIn(1, 1000, "within [1, 1000]"));
-  app.add_flag("--peer-guess", o.peer_guess,
-               "give the OpenCV odometries the last motion as the initial guess (OpenCV's "
-               "sample gives none)");
+  app.add_option("--peer-guess", o.peer_guess,
+                 "the OpenCV odometries' initial guess, one row per value: none (as OpenCV's "
+                 "sample) or last (the last frame's motion)")
+      ->type_name("LIST")
+      ->delimiter(',')
+      ->allow_extra_args(false)
+      ->default_str("none,last")
+      ->check(CLI::IsMember({"none", "last"}).description(""));
   app.add_option("--camera", o.camera,
                  "every method's intrinsics, and a lens distortion the frames are undistorted by "
                  "(default: each DATASET_DIR/camera.yaml, else default)")
@@ -135,6 +142,7 @@ std::optional<int> parseOptions(CLI::App& app, Options& o, int argc, char** argv
   // --methods "" or ",": CLI11 leaves the list empty.
   if (o.methods.empty()) return acvo::tools::usageError(app, "--methods is empty");
   if (o.peer_max_depth.empty()) return acvo::tools::usageError(app, "--peer-max-depth is empty");
+  if (o.peer_guess.empty()) return acvo::tools::usageError(app, "--peer-guess is empty");
   if (o.threads.empty()) return acvo::tools::usageError(app, "--threads is empty");
   return std::nullopt;
 }
@@ -227,13 +235,15 @@ std::string threadsSetting(int threads) {
   return std::to_string(threads) + (threads == 1 ? "_thread" : "_threads");
 }
 
-std::string depthSetting(double max_depth) {
+// "4m", "10m_guess": the maximum depth, and whether the last motion is the initial guess.
+std::string peerSetting(double max_depth, bool guess) {
   std::ostringstream s;
-  s << max_depth << "m";
+  s << max_depth << "m" << (guess ? "_guess" : "");
   return s.str();
 }
 
-// The rows of one dataset: acvo once per thread count, each peer once per maximum depth.
+// The rows of one dataset: acvo once per thread count, each peer once per maximum depth and
+// initial guess.
 std::vector<Entry> entriesFor(const Options& opt, const acvo::Params& params,
                               const acvo::TumDataset& data, const std::string& dataset,
                               const Eigen::Isometry3d& start) {
@@ -249,14 +259,17 @@ std::vector<Entry> entriesFor(const Options& opt, const acvo::Params& params,
       continue;
     }
     for (double max_depth : opt.peer_max_depth) {
-      acvo::peers::PeerSetup setup;
-      setup.kind = acvo::peers::parsePeerKind(method);
-      setup.max_depth = max_depth;
-      setup.previous_motion_guess = opt.peer_guess;
-      const acvo::Camera camera = data.camera();
-      entries.push_back({makeRow(dataset, method, depthSetting(max_depth)), [setup, camera, start] {
-                           return std::make_unique<PeerMethod>(setup, camera, start);
-                         }});
+      for (const std::string& guess : opt.peer_guess) {
+        acvo::peers::PeerSetup setup;
+        setup.kind = acvo::peers::parsePeerKind(method);
+        setup.max_depth = max_depth;
+        setup.previous_motion_guess = guess == "last";
+        const acvo::Camera camera = data.camera();
+        entries.push_back({makeRow(dataset, method, peerSetting(max_depth, guess == "last")),
+                           [setup, camera, start] {
+                             return std::make_unique<PeerMethod>(setup, camera, start);
+                           }});
+      }
     }
   }
   return entries;
@@ -390,7 +403,7 @@ void printTable(const std::vector<Row>& rows, const Options& opt) {
           ? "; the frames' stamps " + milliseconds(*opt.offset) + " against the reference's"
           : "";
   std::printf("# acvo on %s; OpenCV odometries serial, as OpenCV's TUM sample runs them (NaN "
-              "holes, no guess); times: median over frames, median of %d run%s interleaved "
+              "holes; _guess: the last motion as initial guess); times: median over frames, median of %d run%s interleaved "
               "frame by frame; vs_rgbd: median time / the best RgbdOdometry setting's, per "
               "run%s%s\n",
               threads.c_str(), opt.repeat, opt.repeat == 1 ? "" : "s", camera.c_str(),
@@ -513,7 +526,8 @@ int main(int argc, char** argv) {
         const bool last_of_method =
             k + 1 == entries.size() || entries[k + 1].row.method != row.method;
         const auto b = best.find(row.method);
-        if (last_of_method && b != best.end() && opt.peer_max_depth.size() > 1) {
+        if (last_of_method && b != best.end() &&
+            opt.peer_max_depth.size() * opt.peer_guess.size() > 1) {
           Row best_row = entries[b->second].row;
           best_row.method += "_best";
           best_row.best = true;
