@@ -91,8 +91,8 @@ const char* const kTopLevelKeys[] = {
     "approx_sync_max_interval", "topic_queue_size", "queue_size", "sync_queue_size", "lost_odom",
     "publish_null_when_lost", "camera", "fx", "fy", "cx", "cy", "initial_pose",
     // the parameter sections (ros_params.hpp), the old one it reports, the transport hints
-    "selection", "registration", "coarse_to_fine", "paper", "odometry", "solver",
-    "image_transport", "depth_image_transport",
+    "selection", "registration", "coarse_to_fine", "paper", "odometry", "solver", "image_transport",
+    "depth_image_transport",
     // diagnostic_updater's own (it reads it from the same private namespace)
     "diagnostic_period"};
 
@@ -221,12 +221,11 @@ std::optional<Eigen::Isometry3d> parsePose6(const std::string& text, std::string
   return pose;
 }
 
-std::vector<std::string> loadNodeletSettings(const XmlRpc::XmlRpcValue& private_ns,
-                                             NodeletSettings& s) {
-  std::vector<std::string> problems;
-  if (private_ns.getType() != XmlRpcValue::TypeStruct) return problems;
-  const XmlRpcValue& ns = private_ns;
+namespace {
 
+// Frames, switches, durations and queue sizes.
+void readFramesAndQueues(const XmlRpcValue& ns, NodeletSettings& s,
+                         std::vector<std::string>& problems) {
   s.odom_frame_id = frameId(ns, "odom_frame_id", s.odom_frame_id, problems);
   s.base_frame_id = frameId(ns, "base_frame_id", s.base_frame_id, problems);
   s.guess_frame_id = frameId(ns, "guess_frame_id", s.guess_frame_id, problems);
@@ -255,7 +254,10 @@ std::vector<std::string> loadNodeletSettings(const XmlRpc::XmlRpcValue& private_
                                 : "; taken as ~sync_queue_size = " + std::to_string(old)));
   }
   readChecked(ns, "sync_queue_size", s.sync_queue_size, at_least_one, ">= 1", problems);
+}
 
+// ~lost_odom, and rtabmap's ~publish_null_when_lost for it.
+void readLostOdom(const XmlRpcValue& ns, NodeletSettings& s, std::vector<std::string>& problems) {
   if (ns.hasMember("lost_odom")) {
     std::string text = toString(s.lost_odom);
     read(ns, "lost_odom", text, problems);
@@ -284,7 +286,10 @@ std::vector<std::string> loadNodeletSettings(const XmlRpc::XmlRpcValue& private_
       }
     }
   }
+}
 
+// ~camera, ~fx, ~fy, ~cx, ~cy: kept only as a whole that makes sense.
+void readIntrinsics(const XmlRpcValue& ns, NodeletSettings& s, std::vector<std::string>& problems) {
   IntrinsicsOverride intrinsics = s.intrinsics;
   read(ns, "camera", intrinsics.camera, problems);
   read(ns, "fx", intrinsics.fx, problems);
@@ -296,7 +301,11 @@ std::vector<std::string> loadNodeletSettings(const XmlRpc::XmlRpcValue& private_
   } else {
     s.intrinsics = intrinsics;
   }
+}
 
+// ~initial_pose: "x y z roll pitch yaw" as a string or a list of numbers.
+void readInitialPose(const XmlRpcValue& ns, NodeletSettings& s,
+                     std::vector<std::string>& problems) {
   if (ns.hasMember("initial_pose")) {
     const XmlRpcValue& v = ns["initial_pose"];
     std::string text;
@@ -329,8 +338,10 @@ std::vector<std::string> loadNodeletSettings(const XmlRpc::XmlRpcValue& private_
       }
     }
   }
+}
 
-  // Combinations that cannot work.
+// Combinations that cannot work, undone with a reason.
+void checkCombinations(NodeletSettings& s, std::vector<std::string>& problems) {
   if (!s.guess_frame_id.empty()) {
     const std::string base = s.base_frame_id;
     std::string why;
@@ -355,6 +366,19 @@ std::vector<std::string> loadNodeletSettings(const XmlRpc::XmlRpcValue& private_
         "using the colour image's frame");
     s.base_is_optical_frame = false;
   }
+}
+
+}  // namespace
+
+std::vector<std::string> loadNodeletSettings(const XmlRpc::XmlRpcValue& private_ns,
+                                             NodeletSettings& s) {
+  std::vector<std::string> problems;
+  if (private_ns.getType() != XmlRpcValue::TypeStruct) return problems;
+  readFramesAndQueues(private_ns, s, problems);
+  readLostOdom(private_ns, s, problems);
+  readIntrinsics(private_ns, s, problems);
+  readInitialPose(private_ns, s, problems);
+  checkCombinations(s, problems);
   return problems;
 }
 

@@ -98,8 +98,16 @@ class OdometryNodelet : public nodelet::Nodelet {
   // drop.
   bool acceptStamp(const ros::Time& stamp, std::string* why);
   void reject(const std_msgs::Header& header, const std::string& why, double ms_total);
+  // The warnings a frame's camera gets once (mono8, unrectified, depth in another frame), and a
+  // new camera frame noted: the colour check looks again and the base transform is looked up.
+  void checkCamera(const acvo::Frame& frame, const std_msgs::Header& header, const Image& depth,
+                   const Info& info);
   // Logs the intrinsics in use when they are new: at the first frame and at a change.
   void noteCamera(const acvo::Camera& camera, const Info& info);
+  // Keeps what diagnostics report of the last frame; says once that the depth is retimed.
+  void noteResult(const acvo::OdometryResult& r);
+  // Counts a lost frame and warns (throttled): what the pose does meanwhile, what comes next.
+  void countLoss(const acvo::OdometryResult& r, bool guessed);
   // Logs the colour check's verdict when it comes (Odometry::colourCheck).
   void logColourVerdict(const acvo::OdometryResult& r);
   std::string baseFrame() const;
@@ -353,6 +361,42 @@ void OdometryNodelet::processFrame(const Image& rgb, const Image& depth, const I
     return;
   }
   const acvo::Frame& frame = std::get<acvo::Frame>(converted);
+  checkCamera(frame, header, depth, info);
+
+  FrameTf tf = frameTf(header.stamp);
+  if (pending_base_pose_ && tf.base_from_camera) {
+    startAt(*pending_base_pose_, *tf.base_from_camera);
+    tf.motion_guess.reset();
+  }
+  acvo::OdometryResult r = odometry_->process(frame, tf.motion_guess);
+  logColourVerdict(r);
+  if (!tf.base_from_camera && r.tracking != acvo::Tracking::kBadFrame) {
+    r.message += std::string(r.message.empty() ? "" : "; ") + "not published: no transform from '" +
+                 baseFrame() + "' to '" + camera_frame_ + "' yet";
+  }
+  noteResult(r);
+  if (r.tracking == acvo::Tracking::kBadFrame) {
+    // The conversion checks what the odometry checks: this is a safety net.
+    reject(header, r.message, acvo::msSince(start));
+    return;
+  }
+  ++count_.frames;
+  stamps_.processed(header.stamp.toSec());
+  const ContinuousOdom::Pose pose =
+      continuous_.update(r, tf.motion_guess, header.stamp.toSec(), params_.odometry);
+  if (r.tracking == acvo::Tracking::kLost) countLoss(r, tf.motion_guess.has_value());
+  publish(r, pose, header, tf);
+  InfoExtras extras;
+  extras.guess_from_tf = tf.motion_guess.has_value() && r.tracking != acvo::Tracking::kFirstFrame;
+  // On the ROS clock, as the stamps are: sim time when a bag is played with --clock.
+  extras.ms_latency = (ros::Time::now() - header.stamp).toSec() * 1000.0;
+  extras.ms_total = acvo::msSince(start);
+  extras.lost_count = count_.lost;
+  publishInfo(r, header, extras);
+}
+
+void OdometryNodelet::checkCamera(const acvo::Frame& frame, const std_msgs::Header& header,
+                                  const Image& depth, const Info& info) {
   if (frame.order == acvo::ColorOrder::kGray) {
     NODELET_WARN_ONCE("%s is mono8: points get intensity and gradient labels but no colour",
                       topics_.rgb.c_str());
@@ -378,18 +422,18 @@ void OdometryNodelet::processFrame(const Image& rgb, const Image& depth, const I
     base_from_camera_.reset();
     base_waited_ = false;
   }
+}
 
-  FrameTf tf = frameTf(header.stamp);
-  if (pending_base_pose_ && tf.base_from_camera) {
-    startAt(*pending_base_pose_, *tf.base_from_camera);
-    tf.motion_guess.reset();
-  }
-  acvo::OdometryResult r = odometry_->process(frame, tf.motion_guess);
-  logColourVerdict(r);
-  if (!tf.base_from_camera && r.tracking != acvo::Tracking::kBadFrame) {
-    r.message += std::string(r.message.empty() ? "" : "; ") + "not published: no transform from '" +
-                 baseFrame() + "' to '" + camera_frame_ + "' yet";
-  }
+void OdometryNodelet::countLoss(const acvo::OdometryResult& r, bool guessed) {
+  ++count_.lost;
+  NODELET_WARN_THROTTLE(2.0, "tracking lost (%s): %s, %s (%u lost so far)", r.message.c_str(),
+                        guessed ? "the pose follows the motion guess" : "holding the last pose",
+                        r.new_keyframe ? "the reference restarts from this frame"
+                                       : "the next frame is registered to the last good one",
+                        count_.lost);
+}
+
+void OdometryNodelet::noteResult(const acvo::OdometryResult& r) {
   last_.tracking = r.tracking;
   last_.message = r.message;
   last_.depth_delay = r.depth_delay;
@@ -402,33 +446,6 @@ void OdometryNodelet::processFrame(const Image& rgb, const Image& depth, const I
                  "moved to its colour's time by the camera's motion (odometry/sync_depth)",
                  1e3 * r.depth_delay);
   }
-  InfoExtras extras;
-  extras.guess_from_tf = tf.motion_guess.has_value() && r.tracking != acvo::Tracking::kFirstFrame;
-  if (r.tracking == acvo::Tracking::kBadFrame) {
-    // The conversion checks what the odometry checks: this is a safety net.
-    reject(header, r.message, acvo::msSince(start));
-    return;
-  }
-  ++count_.frames;
-  stamps_.processed(header.stamp.toSec());
-  const ContinuousOdom::Pose pose =
-      continuous_.update(r, tf.motion_guess, header.stamp.toSec(), params_.odometry);
-
-  if (r.tracking == acvo::Tracking::kLost) {
-    ++count_.lost;
-    NODELET_WARN_THROTTLE(2.0, "tracking lost (%s): %s, %s (%u lost so far)", r.message.c_str(),
-                          tf.motion_guess ? "the pose follows the motion guess"
-                                          : "holding the last pose",
-                          r.new_keyframe ? "the reference restarts from this frame"
-                                         : "the next frame is registered to the last good one",
-                          count_.lost);
-  }
-  publish(r, pose, header, tf);
-  // On the ROS clock, as the stamps are: sim time when a bag is played with --clock.
-  extras.ms_latency = (ros::Time::now() - header.stamp).toSec() * 1000.0;
-  extras.ms_total = acvo::msSince(start);
-  extras.lost_count = count_.lost;
-  publishInfo(r, header, extras);
 }
 
 bool OdometryNodelet::acceptStamp(const ros::Time& stamp, std::string* why) {

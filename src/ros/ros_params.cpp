@@ -7,6 +7,8 @@
 #include <sstream>
 #include <stdexcept>
 #include <type_traits>
+#include <utility>
+#include <vector>
 
 #include <dynamic_reconfigure/Config.h>
 
@@ -58,14 +60,15 @@ std::string set(const std::string& key, const XmlRpcValue& v, Enum& field) {
 
 }  // namespace
 
-std::vector<std::string> applyRosParams(const XmlRpc::XmlRpcValue& private_ns,
-                                        acvo::Params& params) {
-  std::vector<std::string> problems;
-  if (private_ns.getType() != XmlRpcValue::TypeStruct) return problems;
-  // The keys the user set. A value of the wrong type is reported and dropped here (on a scratch
-  // copy); the others are applied one at a time below.
-  std::set<std::string> known;
-  std::vector<std::pair<std::string, std::string>> given;  // (section, name)
+namespace {
+
+using Key = std::pair<std::string, std::string>;  // (section, name)
+
+// The keys the user set, each of the right type; a value of the wrong type is reported (on a
+// scratch copy) and left out. `known` gets every section/name there is.
+std::vector<Key> givenValues(const XmlRpcValue& private_ns, const acvo::Params& params,
+                             std::set<std::string>& known, std::vector<std::string>& problems) {
+  std::vector<Key> given;
   acvo::Params scratch = params;
   visitParams(scratch, [&](const std::string& section, const std::string& name, auto& field) {
     known.insert(section + "/" + name);
@@ -79,11 +82,16 @@ std::vector<std::string> applyRosParams(const XmlRpc::XmlRpcValue& private_ns,
       problems.push_back(problem);
     }
   });
-  // Each given value alone on top of what is accepted so far; one that makes the set invalid
-  // (a range, or an order with another parameter) is tried again after the others, in case a
-  // partner it needs comes later (ell_min raised with ell_init), and otherwise rejected by
-  // itself: every other value the user gave is kept.
-  const auto with = [&](acvo::Params base, const std::pair<std::string, std::string>& key) {
+  return given;
+}
+
+// Each given value alone on top of what is accepted so far; one that makes the set invalid (a
+// range, or an order with another parameter) is tried again after the others, in case a partner
+// it needs comes later (ell_min raised with ell_init), and otherwise rejected by itself: every
+// other value the user gave is kept.
+acvo::Params applyEachAlone(const XmlRpcValue& private_ns, const acvo::Params& params,
+                            std::vector<Key> given, std::vector<std::string>& problems) {
+  const auto with = [&](acvo::Params base, const Key& key) {
     visitParams(base, [&](const std::string& section, const std::string& name, auto& field) {
       if (section == key.first && name == key.second) {
         set(section + "/" + name, private_ns[section][name], field);  // its type was checked
@@ -110,7 +118,13 @@ std::vector<std::string> applyRosParams(const XmlRpc::XmlRpcValue& private_ns,
                        acvo::validate(with(accepted, key)) +
                        "); it keeps its default, the other parameters are used");
   }
-  params = accepted;
+  return accepted;
+}
+
+// Keys in the parameter sections that name no parameter, with the closest one that does; the
+// old ~solver section.
+void reportUnknown(const XmlRpcValue& private_ns, const std::set<std::string>& known,
+                   std::vector<std::string>& problems) {
   if (private_ns.hasMember("solver")) {
     problems.push_back("~solver was split (ignored): ~registration/engine chooses the engine, "
                        "~coarse_to_fine and ~paper hold each engine's parameters "
@@ -131,6 +145,18 @@ std::vector<std::string> applyRosParams(const XmlRpc::XmlRpcValue& private_ns,
       }
     }
   }
+}
+
+}  // namespace
+
+std::vector<std::string> applyRosParams(const XmlRpc::XmlRpcValue& private_ns,
+                                        acvo::Params& params) {
+  std::vector<std::string> problems;
+  if (private_ns.getType() != XmlRpcValue::TypeStruct) return problems;
+  std::set<std::string> known;
+  std::vector<Key> given = givenValues(private_ns, params, known, problems);
+  params = applyEachAlone(private_ns, params, std::move(given), problems);
+  reportUnknown(private_ns, known, problems);
   return problems;
 }
 
