@@ -40,6 +40,7 @@ from tf2_msgs.msg import TFMessage
 
 sys.path.insert(0, os.path.dirname(os.path.realpath(__file__)))
 import robot_bag  # noqa: E402
+from bound_lines import check_bound, check_timing  # noqa: E402
 
 from acvo.msg import OdometryInfo  # noqa: E402
 
@@ -68,20 +69,6 @@ def executable(name):
     if not paths:
         raise RuntimeError("%s not found in package acvo (built?)" % name)
     return paths[0]
-
-
-def check_bound(test, what, figure, bound, unit):
-    """figure < bound, printed as scripts/measure_ros_bounds reads it."""
-    print("[ BOUND ] %s: %.6g %s (bound < %.6g)" % (what, figure, unit, bound))
-    test.assertLess(figure, bound, what)
-
-
-def check_timing(test, what, figure, bound, unit, catches):
-    """figure < bound, a bound that is no multiple of a measurement: `catches` says what it
-    is there for; printed as scripts/measure_ros_bounds reads it."""
-    print("[ TIMING ] %s: %.6g %s (bound < %.6g; catches %s)" % (what, figure, unit, bound,
-                                                                  catches))
-    test.assertLess(figure, bound, what)
 
 
 def rotation_angle(r):

@@ -20,6 +20,9 @@ import roslib.packages
 import rostest
 import yaml
 
+sys.path.insert(0, os.path.dirname(os.path.realpath(__file__)))
+from bound_lines import check_bound  # noqa: E402
+
 FRAMES = 30
 # The figures beside each bound are what scripts/measure_ros_bounds printed (it runs this test
 # and reads its [ BOUND ] lines); each bound is 2.5x its figure.
@@ -73,12 +76,6 @@ def matrix(values):
 
 def rotation_angle(r):
     return float(np.arccos(np.clip((np.trace(r) - 1) / 2, -1.0, 1.0)))
-
-
-def check_bound(test, what, figure, bound, unit):
-    """figure < bound, printed as scripts/measure_ros_bounds reads it."""
-    print("[ BOUND ] %s: %.6g %s (bound < %.6g)" % (what, figure, unit, bound))
-    test.assertLess(figure, bound, what)
 
 
 def worst_relative_error(estimate, reference, stamps):
