@@ -25,6 +25,16 @@ RodriguesCoefficients coefficients(double theta) {
   return {s / theta, (1.0 - c) / t2, (theta - s) / (t2 * theta)};
 }
 
+// D of SO(3)'s V^-1 = I - W/2 + D W^2 (also its left Jacobian's inverse), series below 0.1.
+double inverseCoefficient(double theta) {
+  if (theta < 0.1) {
+    const double t2 = theta * theta;
+    return 1.0 / 12.0 + t2 / 720.0 + t2 * t2 / 30240.0 + t2 * t2 * t2 / 1209600.0;
+  }
+  const auto k = coefficients(theta);
+  return (1.0 - k.A / (2.0 * k.B)) / (theta * theta);
+}
+
 }  // namespace
 
 Eigen::Matrix3d hat(const Eigen::Vector3d& w) {
@@ -80,14 +90,7 @@ Vector6d logSE3(const Eigen::Isometry3d& T) {
   const double theta = w.norm();
   const Eigen::Matrix3d W = hat(w);
   // V^-1 = I - W/2 + D W^2 with D = (1 - A / (2B)) / theta^2.
-  double D;
-  if (theta < 0.1) {
-    const double t2 = theta * theta;
-    D = 1.0 / 12.0 + t2 / 720.0 + t2 * t2 / 30240.0 + t2 * t2 * t2 / 1209600.0;
-  } else {
-    const auto k = coefficients(theta);
-    D = (1.0 - k.A / (2.0 * k.B)) / (theta * theta);
-  }
+  const double D = inverseCoefficient(theta);
   const Eigen::Vector3d v =
       T.translation() - 0.5 * (W * T.translation()) + D * (W * (W * T.translation()));
   // Two assignments, not `xi << w, v`: GCC 12 warns (-Warray-bounds, a false positive) about
@@ -96,6 +99,35 @@ Vector6d logSE3(const Eigen::Isometry3d& T) {
   xi.head<3>() = w;
   xi.tail<3>() = v;
   return xi;
+}
+
+Matrix6d leftJacobianInverseSE3(const Vector6d& xi) {
+  const Eigen::Vector3d w = xi.head<3>();
+  const double theta = w.norm(), t2 = theta * theta;
+  const Eigen::Matrix3d P = hat(w), R = hat(xi.tail<3>());
+  const Eigen::Matrix3d J_inv =
+      Eigen::Matrix3d::Identity() - 0.5 * P + inverseCoefficient(theta) * P * P;
+  // Q's coefficients (theta - sin)/theta^3, (theta^2 + 2 cos - 2)/(2 theta^4) and
+  // (2 theta - 3 sin + theta cos)/(2 theta^5), as series below 0.1 where they cancel.
+  double c1, c2, c3;
+  if (theta < 0.1) {
+    c1 = coefficients(theta).C;
+    c2 = 1.0 / 24.0 - t2 / 720.0 + t2 * t2 / 40320.0;
+    c3 = 1.0 / 120.0 - t2 / 2520.0 + t2 * t2 / 120960.0;
+  } else {
+    const double s = std::sin(theta), c = std::cos(theta);
+    c1 = (theta - s) / (t2 * theta);
+    c2 = (t2 + 2.0 * c - 2.0) / (2.0 * t2 * t2);
+    c3 = (2.0 * theta - 3.0 * s + theta * c) / (2.0 * t2 * t2 * theta);
+  }
+  const Eigen::Matrix3d PR = P * R, RP = R * P, PRP = PR * P;
+  const Eigen::Matrix3d Q = 0.5 * R + c1 * (PR + RP + PRP) + c2 * (P * PR + RP * P - 3.0 * PRP) +
+                            c3 * (PRP * P + P * PRP);
+  Matrix6d out = Matrix6d::Zero();
+  out.topLeftCorner<3, 3>() = J_inv;
+  out.bottomRightCorner<3, 3>() = J_inv;
+  out.bottomLeftCorner<3, 3>() = -J_inv * Q * J_inv;
+  return out;
 }
 
 Eigen::Isometry3d normalized(const Eigen::Isometry3d& T) {
