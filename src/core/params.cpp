@@ -193,6 +193,7 @@ void checkOdometry(std::ostringstream& why, const OdometryParams& od) {
   check(why, od.keyframe_matched_fraction >= 0.0 && od.keyframe_matched_fraction <= 1.0,
         "odometry.keyframe_matched_fraction", "must lie within [0, 1]");
   check(why, od.keyframe_translation > 0.0, "odometry.keyframe_translation", "must be positive");
+  check(why, od.window_keyframes >= 0, "odometry.window_keyframes", "must not be negative");
   check(why, od.keyframe_rotation > 0.0, "odometry.keyframe_rotation", "must be positive");
   check(why, od.lost_speed >= 0.0, "odometry.lost_speed", "must not be negative");
   check(why, od.lost_angular_speed >= 0.0, "odometry.lost_angular_speed", "must not be negative");

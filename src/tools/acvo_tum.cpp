@@ -116,7 +116,8 @@ class StatsWriter {
                    : std::vector<std::string>{"brightness_gain", "vignetting", "dense_weight"};
     out_ << "frame,stamp,tracking,status,points,fixed_points,iterations,ell,nnz,matched_fraction,"
             "ms_selection,ms_labels,ms_prepare,ms_cloud,ms_neighbours,ms_registration,ms_frame,"
-            "rss_kib,keyframe,new_keyframe,depth_delay_ms,depth_moved,second_start";
+            "rss_kib,keyframe,new_keyframe,depth_delay_ms,depth_moved,second_start,ms_window,"
+            "window_links,window_shift_mm,window_shift_deg";
     for (const auto& name : figures_) out_ << ',' << name;
     out_ << '\n';
   }
@@ -128,10 +129,11 @@ class StatsWriter {
          << s.iterations << ',' << s.ell << ',' << s.nnz << ',' << s.matched_fraction << ','
          << r.cloud_stats.ms_selection << ',' << r.cloud_stats.ms_labels << ',' << r.ms_prepare
          << ',' << r.ms_cloud << ',' << s.ms_neighbours << ',' << r.ms_registration << ','
-         << r.ms_cloud + r.ms_registration << ',' << acvo::tools::residentKiB() << ','
+         << r.ms_cloud + r.ms_registration + r.ms_window << ',' << acvo::tools::residentKiB() << ','
          << r.keyframe_index << ',' << int(r.new_keyframe) << ',' << 1e3 * r.depth_delay << ','
          << (r.depth_retimed ? 2 : int(r.depth_synced)) << ','
-         << (r.second_start_kept ? 2 : int(r.second_start));
+         << (r.second_start_kept ? 2 : int(r.second_start)) << ',' << r.ms_window << ','
+         << r.window_links << ',' << 1e3 * r.window_shift << ',' << r.window_shift_deg;
     const auto figures = acvo::engineFigures(s);
     for (const auto& name : figures_) {
       const auto it = std::find_if(figures.begin(), figures.end(),

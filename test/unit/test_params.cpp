@@ -55,7 +55,7 @@ TEST(Params, ConfigFileHoldsEveryKeyWithTheStructDefaults) {
   const Params loaded = loadParams(path);
   const auto got = flatten(loaded);
   const auto want = flatten(Params());
-  ASSERT_EQ(got.size(), 74u);  // every parameter of visitParams
+  ASSERT_EQ(got.size(), 75u);  // every parameter of visitParams
   EXPECT_EQ(got, want);
   // Equal values could also come from keys missing in the file: check that each key of the
   // sections the default engine reads is written, and that the other engine's is not there.

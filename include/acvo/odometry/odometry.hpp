@@ -6,9 +6,12 @@
 
 #include <cmath>
 #include <cstdint>
+#include <deque>
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <Eigen/Geometry>
 
@@ -74,6 +77,14 @@ struct OdometryResult {
   double ms_cloud = 0.0;
   double ms_prepare = 0.0;
   double ms_registration = 0.0;
+  // The local window (docs/method.md §7.7), when this frame became a keyframe: the time of its
+  // registrations to the older keyframes in the window, its links to older keyframes (the one to
+  // the keyframe it was registered to included), and how far the refinement moved its pose from
+  // where that registration put it (m, deg). `pose` is the refined pose.
+  double ms_window = 0.0;
+  int window_links = 0;
+  double window_shift = 0.0;
+  double window_shift_deg = 0.0;
   CloudStats cloud_stats;
   // The colour check's verdict became known with this frame (Odometry::colourCheck()), and
   // whether this frame's colour was resampled to the depth camera (from the frame after an
@@ -99,6 +110,9 @@ Frame depthAsRegistered(const Frame& frame, const OdometryResult& r);
 //    driver).
 //  - a lost frame keeps the last good pose (its covariance grows with lostGrowth), drops the
 //    velocity, and replaces the reference by replacesReference.
+//  - local window (odometry.window_keyframes, window.cpp): a frame that becomes a keyframe is
+//    also registered to the older keyframes in the window, and the window's poses are refined
+//    together before its pose is given out; no pose given out changes afterwards.
 class Odometry {
  public:
   explicit Odometry(const Params& params = Params());
@@ -171,6 +185,13 @@ class Odometry {
   void tracked(OdometryResult& r, const Registration& reg, double stamp);
   void lost(OdometryResult& r, const Registration& reg, double stamp);
   void lookAtColour(const Frame& frame, OdometryResult& r);
+  // The local window (window.cpp): `frame`, registered to the current keyframe, becomes the
+  // keyframe; in the window, it is registered to the older keyframes too and its pose refined.
+  void newKeyframe(OdometryResult& r, Tracked frame);
+  void enterWindow(OdometryResult& r, Tracked& frame);
+  void linkToOlderKeyframes(OdometryResult& r, const Tracked& frame);
+  void leaveWindow(std::size_t size);
+  void refineWindow(Tracked& frame);
 
   // The motion between the two frames of the last velocity over `seconds`, and that velocity as
   // a twist per second; none until two frames were tracked.
@@ -179,6 +200,9 @@ class Odometry {
   // `cloud` with the search structures of a reference built, timed into r.
   std::shared_ptr<PreparedCloud> asReference(OdometryResult& r,
                                              const std::shared_ptr<PreparedCloud>& cloud);
+  // One registration in the solver's thread pool.
+  SolverResult alignInArena(const PreparedCloud& fixed, const PreparedCloud& moving,
+                            const Eigen::Isometry3d& guess, AlignStages stages) const;
   // The engine for the colour camera's verdict (engineParams()).
   void makeEngine();
 
@@ -195,6 +219,19 @@ class Odometry {
   SecondStart second_start_;
   std::optional<Tracked> keyframe_;
   std::optional<Tracked> last_;  // the last tracked frame (the keyframe itself, or after it)
+  // The local window: its keyframes, oldest first, the current keyframe last (empty without a
+  // window), and the registrations that link them, by frame index.
+  struct Link {
+    std::uint64_t fixed = 0;
+    std::uint64_t moving = 0;
+    Eigen::Isometry3d measured = Eigen::Isometry3d::Identity();
+    Matrix6d information = Matrix6d::Zero();
+  };
+  std::deque<Tracked> window_;
+  std::vector<Link> links_;
+  // Keyframes that left the window, with their last poses, held fixed while a keyframe in the
+  // window is linked to them.
+  std::vector<std::pair<std::uint64_t, Eigen::Isometry3d>> anchors_;
   int lost_in_a_row_ = 0;
   std::uint64_t frames_ = 0;  // frames numbered so far
   ColourCamera colour_;

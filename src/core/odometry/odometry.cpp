@@ -190,8 +190,8 @@ Odometry::Registration Odometry::registerFrame(OdometryResult& r, const Frame& f
     Registration to_last = registerTo(*last_, current, prior, frame, r, facts);
     r.ms_registration += to_last.solver.ms_total;
     if (to_last.judgement.tracking != Tracking::kLost) {
-      keyframe_ = last_;
-      keyframe_->to_keyframe = last_->to_keyframe = Eigen::Isometry3d::Identity();
+      newKeyframe(r, *last_);
+      last_ = keyframe_;
       reg = std::move(to_last);
       r.fell_back_to_previous = true;
     }
@@ -315,11 +315,12 @@ void Odometry::tracked(OdometryResult& r, const Registration& reg, double stamp)
   Tracked frame{reg.moving, r.frame_index, pose_, pose_covariance_, to_keyframe, reg.covariance};
   if (params_.odometry.reference == Reference::kPreviousFrame ||
       takesKeyframe(reg.judgement, reg.solver, params_.odometry)) {
-    frame.to_keyframe = Eigen::Isometry3d::Identity();
-    frame.to_keyframe_covariance = Matrix6d::Zero();
     frame.cloud = asReference(r, reg.moving);
-    keyframe_ = frame;
+    newKeyframe(r, std::move(frame));
+    pose_ = r.pose = keyframe_->pose;  // refined in the window (when there is one)
+    last_ = keyframe_;
     r.new_keyframe = true;
+    return;
   }
   last_ = std::move(frame);
 }
@@ -341,6 +342,7 @@ void Odometry::lost(OdometryResult& r, const Registration& reg, double stamp) {
     pose_covariance_ = r.pose_covariance;
     keyframe_ = last_ = Tracked{asReference(r, reg.moving), r.frame_index, pose_,
                                 pose_covariance_, Eigen::Isometry3d::Identity()};
+    window_.clear();  // nothing links the new reference to the window's keyframes
     r.new_keyframe = true;
   }
 }
@@ -355,6 +357,7 @@ void Odometry::reset(const Eigen::Isometry3d& pose, const Matrix6d& covariance) 
   second_start_.forget();
   keyframe_.reset();
   last_.reset();
+  window_.clear();
   lost_in_a_row_ = 0;
 }
 
@@ -375,6 +378,13 @@ std::optional<Vector6d> Odometry::lastVelocity() const {
 std::optional<Eigen::Isometry3d> Odometry::motionOver(double seconds) const {
   if (!(velocity_interval_ > 0.0)) return std::nullopt;
   return atConstantVelocity(velocity_, velocity_interval_, seconds);
+}
+
+SolverResult Odometry::alignInArena(const PreparedCloud& fixed, const PreparedCloud& moving,
+                                    const Eigen::Isometry3d& guess, AlignStages stages) const {
+  SolverResult s;
+  arena_->arena.execute([&] { s = engine_->align(fixed, moving, guess, stages); });
+  return s;
 }
 
 std::shared_ptr<PreparedCloud> Odometry::asReference(OdometryResult& r,

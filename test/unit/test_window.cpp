@@ -1,0 +1,202 @@
+// The local window's cost, gradient and refinement (odometry/window.hpp, docs/method.md §7.7).
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "acvo/odometry/odometry.hpp"
+#include "acvo/odometry/window.hpp"
+#include "synth/sequence.hpp"
+
+namespace acvo {
+namespace {
+
+Vector6d randomTwist(std::mt19937& rng, double rot, double trans) {
+  std::normal_distribution<double> n(0.0, 1.0);
+  Vector6d xi;
+  for (int k = 0; k < 3; ++k) xi[k] = rot * n(rng);
+  for (int k = 3; k < 6; ++k) xi[k] = trans * n(rng);
+  return xi;
+}
+
+// A positive definite information with rotation-translation coupling, as a registration's.
+Matrix6d randomInformation(std::mt19937& rng) {
+  Matrix6d a;
+  std::normal_distribution<double> n(0.0, 1.0);
+  for (int r = 0; r < 6; ++r) {
+    for (int c = 0; c < 6; ++c) a(r, c) = n(rng);
+  }
+  return a * a.transpose() + 6.0 * Matrix6d::Identity();
+}
+
+// Four keyframes moving along a hand-held path; every pair linked, each link's measurement the
+// true relative motion times an error.
+struct Window {
+  std::vector<Eigen::Isometry3d> truth, poses;
+  std::vector<WindowLink> links;
+};
+
+Window makeWindow(std::mt19937& rng, double measurement_error, double pose_error) {
+  Window w;
+  Eigen::Isometry3d pose = expSE3(randomTwist(rng, 0.5, 1.0));
+  for (int k = 0; k < 4; ++k) {
+    w.truth.push_back(pose);
+    pose = pose * expSE3(randomTwist(rng, 0.05, 0.05));
+  }
+  for (int m = 1; m < 4; ++m) {
+    for (int f = 0; f < m; ++f) {
+      const Eigen::Isometry3d relative =
+          w.truth[std::size_t(f)].inverse() * w.truth[std::size_t(m)];
+      w.links.push_back({f, m,
+                         expSE3(randomTwist(rng, measurement_error, measurement_error)) * relative,
+                         randomInformation(rng)});
+    }
+  }
+  for (const Eigen::Isometry3d& t : w.truth) {
+    w.poses.push_back(expSE3(randomTwist(rng, pose_error, pose_error)) * t);
+  }
+  w.poses[0] = w.truth[0];
+  return w;
+}
+
+TEST(Window, GradientMatchesFiniteDifferencesOfTheCost) {
+  // Far from the optimum (links 0.05 rad / m off, poses 0.1 off), where the left Jacobian's
+  // inverse is not the identity.
+  std::mt19937 rng(3);
+  for (int trial = 0; trial < 5; ++trial) {
+    Window w = makeWindow(rng, 0.05, 0.1);
+    const Eigen::VectorXd g = windowGradient(w.poses, w.links);
+    const double h = 1e-6;
+    for (std::size_t p = 0; p < w.poses.size(); ++p) {
+      for (int k = 0; k < 6; ++k) {
+        std::vector<Eigen::Isometry3d> plus = w.poses, minus = w.poses;
+        plus[p] = expSE3(Vector6d::Unit(k) * h) * w.poses[p];
+        minus[p] = expSE3(-Vector6d::Unit(k) * h) * w.poses[p];
+        const double numeric = (windowCost(plus, w.links) - windowCost(minus, w.links)) / (2.0 * h);
+        EXPECT_NEAR(g[Eigen::Index(6 * p) + k], numeric, 1e-6 * (1.0 + std::abs(numeric)))
+            << "pose " << p << " coordinate " << k;
+      }
+    }
+  }
+}
+
+TEST(Window, RefinementReachesTheMinimumAndHoldsTheFirstPose) {
+  std::mt19937 rng(5);
+  Window w = makeWindow(rng, 0.01, 0.05);
+  const Eigen::Isometry3d first = w.poses[0];
+  const double before = windowCost(w.poses, w.links);
+  const int iterations = refineWindow(w.poses, w.links);
+  EXPECT_GT(iterations, 1);
+  EXPECT_LT(iterations, 10);
+  EXPECT_LT(windowCost(w.poses, w.links), 0.5 * before);
+  // A minimum: the gradient of every free pose vanishes, and no small move of one lowers the
+  // cost.
+  const Eigen::VectorXd g = windowGradient(w.poses, w.links);
+  EXPECT_LT(g.tail(g.size() - 6).norm(), 1e-9);
+  const double at_minimum = windowCost(w.poses, w.links);
+  for (std::size_t p = 1; p < w.poses.size(); ++p) {
+    for (int k = 0; k < 6; ++k) {
+      std::vector<Eigen::Isometry3d> moved = w.poses;
+      moved[p] = expSE3(Vector6d::Unit(k) * 1e-4) * w.poses[p];
+      EXPECT_GT(windowCost(moved, w.links), at_minimum);
+    }
+  }
+  EXPECT_TRUE(w.poses[0].isApprox(first, 0.0));
+}
+
+TEST(Window, ConsistentLinksGiveTheTruePosesExactly) {
+  std::mt19937 rng(9);
+  Window w = makeWindow(rng, 0.0, 0.1);
+  refineWindow(w.poses, w.links);
+  for (std::size_t k = 0; k < w.poses.size(); ++k) {
+    EXPECT_LT(logSE3(w.truth[k].inverse() * w.poses[k]).norm(), 1e-10) << "pose " << k;
+  }
+}
+
+TEST(Window, TheBetterLinkWeighsMore) {
+  // Two keyframes linked to the fixed one: directly (b), and through a (a then b). A direct link
+  // ten times more informative than the chain pulls b ten times closer to itself.
+  std::vector<Eigen::Isometry3d> poses(3, Eigen::Isometry3d::Identity());
+  const Eigen::Isometry3d step(Eigen::Translation3d(0.1, 0.0, 0.0));
+  const Eigen::Isometry3d direct(Eigen::Translation3d(0.2 + 0.011, 0.0, 0.0));
+  const Matrix6d info = Matrix6d::Identity();
+  const std::vector<WindowLink> links{
+      {0, 1, step, 2.0 * info}, {1, 2, step, 2.0 * info}, {0, 2, direct, 10.0 * info}};
+  poses[1] = step;
+  poses[2] = step * step;
+  refineWindow(poses, links);
+  // Chain information 1 (two links of 2 in series), direct 10: b at 0.2 + 0.011 * 10/11.
+  EXPECT_NEAR(poses[2].translation().x(), 0.2 + 0.011 * 10.0 / 11.0, 1e-9);
+  EXPECT_NEAR(poses[1].translation().x(), 0.1 + 0.011 * 10.0 / 11.0 / 2.0, 1e-9);
+}
+
+TEST(Window, HeldPosesStayAndAnUnlinkedPoseKeepsItsValue) {
+  std::mt19937 rng(11);
+  Window w = makeWindow(rng, 0.01, 0.05);
+  const std::vector<Eigen::Isometry3d> before = w.poses;
+  // Only the links of pose 3 to the two held poses: pose 2 is reached by none.
+  std::vector<WindowLink> links;
+  for (const WindowLink& l : w.links) {
+    if (l.moving == 3 && l.fixed < 2) links.push_back(l);
+  }
+  refineWindow(w.poses, links, 2);
+  EXPECT_TRUE(w.poses[0].isApprox(before[0], 0.0));
+  EXPECT_TRUE(w.poses[1].isApprox(before[1], 0.0));
+  EXPECT_TRUE(w.poses[2].isApprox(before[2], 1e-12));
+  EXPECT_FALSE(w.poses[3].isApprox(before[3], 1e-6));
+  EXPECT_LT(windowGradient(w.poses, links).tail<6>().norm(), 1e-8);
+}
+
+// The odometry with its window: a rendered hand-held camera (0.6 m/s, Kinect-like noise), so
+// that keyframes come every few frames and link to the older ones in the window.
+struct WindowRun {
+  std::vector<Eigen::Isometry3d> published;
+  int refined = 0;       // keyframes the window moved from their registration to the last
+  int multi_linked = 0;  // keyframes linked to more than one older keyframe
+};
+
+WindowRun runWindow(const synth::SynthSequence& seq, int frames, const Params& p) {
+  Odometry odo(p);
+  odo.reset(seq.poses()[0]);
+  WindowRun run;
+  for (int i = 0; i < frames; ++i) {
+    const OdometryResult r = odo.process(seq.frame(i).toFrame());
+    EXPECT_NE(r.tracking, Tracking::kLost) << "frame " << i;
+    // What the odometry holds as its pose is what it published.
+    EXPECT_TRUE(odo.pose().isApprox(r.pose, 0.0)) << "frame " << i;
+    run.published.push_back(r.pose);
+    run.refined += r.window_shift > 0.0;
+    run.multi_linked += r.window_links > 1;
+  }
+  return run;
+}
+
+TEST(WindowOdometry, APublishedPoseNeverChangesWithLaterFrames) {
+  synth::SequenceOptions o;
+  o.frames = 36;
+  o.speed = 0.6;
+  const synth::SynthSequence seq(o);
+  Params p;
+  p.odometry.window_keyframes = 4;
+  p.odometry.threads = 1;
+  const WindowRun whole = runWindow(seq, o.frames, p);
+  EXPECT_GE(whole.multi_linked, 3);
+  EXPECT_GE(whole.refined, 3);
+  // The sequence cut short after frame k gives frame k the pose the whole run published for it:
+  // no published pose depends on a later frame.
+  for (const int k : {9, 20, 35}) {
+    const WindowRun cut = runWindow(seq, k + 1, p);
+    EXPECT_TRUE(cut.published.back().isApprox(whole.published[std::size_t(k)], 0.0))
+        << "frame " << k;
+  }
+  // The window changes the trajectory: without it, the poses after the first refined keyframe
+  // differ.
+  p.odometry.window_keyframes = 2;
+  const WindowRun alone = runWindow(seq, o.frames, p);
+  EXPECT_EQ(alone.refined, 0);
+  EXPECT_EQ(alone.multi_linked, 0);
+  EXPECT_FALSE(alone.published.back().isApprox(whole.published.back(), 1e-9));
+}
+
+}  // namespace
+}  // namespace acvo
