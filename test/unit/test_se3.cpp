@@ -4,17 +4,12 @@
 #include <gtest/gtest.h>
 
 #include "acvo/math/se3.hpp"
+#include "se3_fixtures.hpp"
 
 namespace acvo {
 namespace {
 
-Vector6d randomTwist(std::mt19937& rng, double rot, double trans) {
-  std::normal_distribution<double> n(0.0, 1.0);
-  Vector6d xi;
-  for (int k = 0; k < 3; ++k) xi[k] = rot * n(rng);
-  for (int k = 3; k < 6; ++k) xi[k] = trans * n(rng);
-  return xi;
-}
+using test::randomTwist;
 
 TEST(Se3, ExpOfLogIsIdentityMap) {
   std::mt19937 rng(1);

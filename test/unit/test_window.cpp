@@ -6,18 +6,13 @@
 
 #include "acvo/odometry/odometry.hpp"
 #include "acvo/odometry/window.hpp"
+#include "se3_fixtures.hpp"
 #include "synth/sequence.hpp"
 
 namespace acvo {
 namespace {
 
-Vector6d randomTwist(std::mt19937& rng, double rot, double trans) {
-  std::normal_distribution<double> n(0.0, 1.0);
-  Vector6d xi;
-  for (int k = 0; k < 3; ++k) xi[k] = rot * n(rng);
-  for (int k = 3; k < 6; ++k) xi[k] = trans * n(rng);
-  return xi;
-}
+using test::randomTwist;
 
 // A positive definite information with rotation-translation coupling, as a registration's.
 Matrix6d randomInformation(std::mt19937& rng) {
