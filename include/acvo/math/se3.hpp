@@ -28,7 +28,7 @@ Matrix6d adjointSE3(const Eigen::Isometry3d& T);
 
 // Inverse of the left Jacobian of SE(3) at xi: d log(exp(a) exp(xi)) / da at a = 0, so that a
 // small left perturbation a of exp(xi) changes its logarithm by J^-1 a. Block form
-// [Jr^-1 0; -Jr^-1 Q Jr^-1  Jr^-1], Jr the rotation's left Jacobian and Q the coupling of
+// [A 0; -A Q A  A], A the inverse of the rotation's left Jacobian and Q the coupling of
 // rotation and translation (Barfoot, State Estimation for Robotics, 2017, eq. 7.86).
 Matrix6d leftJacobianInverseSE3(const Vector6d& xi);
 

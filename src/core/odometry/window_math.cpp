@@ -4,6 +4,11 @@
 #include <Eigen/Cholesky>
 
 namespace acvo {
+
+Vector6d linkResidual(const std::vector<Eigen::Isometry3d>& poses, const WindowLink& link) {
+  return logSE3(poses[link.fixed].inverse() * poses[link.moving] * link.measured.inverse());
+}
+
 namespace {
 
 // r and its Jacobians with respect to left perturbations of the fixed and the moving pose:
@@ -15,18 +20,13 @@ struct Linearised {
 };
 
 Linearised linearise(const std::vector<Eigen::Isometry3d>& poses, const WindowLink& link) {
-  const Eigen::Isometry3d fixed_inverse = poses[link.fixed].inverse();
   Linearised l;
-  l.r = logSE3(fixed_inverse * poses[link.moving] * link.measured.inverse());
-  l.d_moving = leftJacobianInverseSE3(l.r) * adjointSE3(fixed_inverse);
+  l.r = linkResidual(poses, link);
+  l.d_moving = leftJacobianInverseSE3(l.r) * adjointSE3(poses[link.fixed].inverse());
   return l;
 }
 
 }  // namespace
-
-Vector6d linkResidual(const std::vector<Eigen::Isometry3d>& poses, const WindowLink& link) {
-  return logSE3(poses[link.fixed].inverse() * poses[link.moving] * link.measured.inverse());
-}
 
 double windowCost(const std::vector<Eigen::Isometry3d>& poses,
                   const std::vector<WindowLink>& links) {
