@@ -305,6 +305,9 @@ TEST(Params, ValidateCatchesInconsistentValues) {
   EXPECT_NE(message([](Params& p) { p.paper.max_step = 0.1; }).find("min_step"),
             std::string::npos);
   EXPECT_NE(message([](Params& p) { p.odometry.threads = -2; }).find("threads"), std::string::npos);
+  EXPECT_NE(message([](Params& p) { p.odometry.window_keyframes = -1; })
+                .find("odometry.window_keyframes"),
+            std::string::npos);
   EXPECT_NE(message([](Params& p) { p.odometry.keyframe_matched_fraction = 1.5; })
                 .find("odometry.keyframe_matched_fraction"),
             std::string::npos);
