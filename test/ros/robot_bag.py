@@ -33,6 +33,9 @@ from geometry_msgs.msg import TransformStamped
 from sensor_msgs.msg import CameraInfo, Image
 from tf2_msgs.msg import TFMessage
 
+sys.path.insert(0, os.path.dirname(os.path.realpath(__file__)))
+from poses import matrix  # noqa: E402
+
 # Per driver: topics, encodings, frames, the depth stamp's offset from the colour stamp.
 DRIVERS = {
     # realsense2_camera, align_depth:=true, enable_sync:=true.
@@ -57,18 +60,6 @@ CAMERA_LINK_TO_CAMERA = (0.0, 0.015, 0.0, 0.0, 0.0, 0.0, 1.0)
 CAMERA_TO_OPTICAL = (0.0, 0.0, 0.0, -0.5, 0.5, -0.5, 0.5)  # REP 103: z forward, x right
 BIAS_SCALE = 1.15  # the biased wheels' translation per step, relative to the truth
 BIAS_YAW = math.radians(0.5)  # added to each step's yaw (rad)
-
-
-def matrix(values):
-    tx, ty, tz, qx, qy, qz, qw = values
-    n = math.sqrt(qx * qx + qy * qy + qz * qz + qw * qw)
-    x, y, z, w = qx / n, qy / n, qz / n, qw / n
-    m = np.eye(4)
-    m[:3, :3] = [[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                 [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                 [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]]
-    m[:3, 3] = [tx, ty, tz]
-    return m
 
 
 def values(m):

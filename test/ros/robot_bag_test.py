@@ -31,7 +31,6 @@ import time
 import unittest
 
 import numpy as np
-import roslib.packages
 import rospy
 import rostest
 from nav_msgs.msg import Odometry
@@ -40,6 +39,7 @@ from tf2_msgs.msg import TFMessage
 
 sys.path.insert(0, os.path.dirname(os.path.realpath(__file__)))
 import robot_bag  # noqa: E402
+from poses import executable, matrix, worst_relative_error  # noqa: E402
 from bound_lines import check_bound, check_timing  # noqa: E402
 
 from acvo.msg import OdometryInfo  # noqa: E402
@@ -64,36 +64,14 @@ MIN_PUBLISHED = 0.6
 CLOCK_SLACK_MS = 5.0
 
 
-def executable(name):
-    paths = [p for p in roslib.packages.find_node("acvo", name) if os.access(p, os.X_OK)]
-    if not paths:
-        raise RuntimeError("%s not found in package acvo (built?)" % name)
-    return paths[0]
-
-
-def rotation_angle(r):
-    return float(np.arccos(np.clip((np.trace(r) - 1) / 2, -1.0, 1.0)))
-
-
 def pose_matrix(pose):
     p, q = pose.position, pose.orientation
-    return robot_bag.matrix((p.x, p.y, p.z, q.x, q.y, q.z, q.w))
+    return matrix((p.x, p.y, p.z, q.x, q.y, q.z, q.w))
 
 
 def transform_matrix(t):
     v, q = t.translation, t.rotation
-    return robot_bag.matrix((v.x, v.y, v.z, q.x, q.y, q.z, q.w))
-
-
-def worst_relative_error(estimate, truth, stamps):
-    """Largest translation and rotation error of the poses relative to the first stamp."""
-    e0, t0 = estimate[stamps[0]], truth[stamps[0]]
-    worst_t, worst_r = 0.0, 0.0
-    for s in stamps:
-        err = np.linalg.inv(np.linalg.inv(t0) @ truth[s]) @ (np.linalg.inv(e0) @ estimate[s])
-        worst_t = max(worst_t, float(np.linalg.norm(err[:3, 3])))
-        worst_r = max(worst_r, rotation_angle(err[:3, :3]))
-    return worst_t, worst_r
+    return matrix((v.x, v.y, v.z, q.x, q.y, q.z, q.w))
 
 
 class Recorder:

@@ -14,14 +14,13 @@ import sys
 import tempfile
 import unittest
 
-import numpy as np
 import rosbag
-import roslib.packages
 import rostest
 import yaml
 
 sys.path.insert(0, os.path.dirname(os.path.realpath(__file__)))
 from bound_lines import check_bound  # noqa: E402
+from poses import executable, matrix, worst_relative_error  # noqa: E402
 
 FRAMES = 30
 # The figures beside each bound are what scripts/measure_ros_bounds printed (it runs this test
@@ -44,51 +43,16 @@ REQUIRE_SHARED = os.environ.get("ACVO_REQUIRE_SHARED_DATA") == "1"
 CONFIG = os.path.join(os.path.dirname(os.path.realpath(__file__)), "test_params.yaml")
 
 
-def executable(name):
-    paths = [p for p in roslib.packages.find_node("acvo", name) if os.access(p, os.X_OK)]
-    if not paths:
-        raise RuntimeError("%s not found in package acvo (built?)" % name)
-    return paths[0]
-
-
 def read_trajectory(path):
+    """A TUM trajectory: stamp (rounded to the microsecond) -> 4x4 pose."""
     rows = {}
     with open(path) as f:
         for line in f:
             parts = line.split()
             if not parts or parts[0].startswith("#"):
                 continue
-            rows[round(float(parts[0]), 6)] = [float(v) for v in parts[1:8]]
+            rows[round(float(parts[0]), 6)] = matrix([float(v) for v in parts[1:8]])
     return rows
-
-
-def matrix(values):
-    tx, ty, tz, qx, qy, qz, qw = values
-    q = np.array([qw, qx, qy, qz]) / np.linalg.norm([qw, qx, qy, qz])
-    w, x, y, z = q
-    m = np.eye(4)
-    m[:3, :3] = [[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                 [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                 [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]]
-    m[:3, 3] = [tx, ty, tz]
-    return m
-
-
-def rotation_angle(r):
-    return float(np.arccos(np.clip((np.trace(r) - 1) / 2, -1.0, 1.0)))
-
-
-def worst_relative_error(estimate, reference, stamps):
-    """Largest translation and rotation error of the poses relative to the first stamp."""
-    e0, r0 = matrix(estimate[stamps[0]]), matrix(reference[stamps[0]])
-    worst_t, worst_r = 0.0, 0.0
-    for s in stamps:
-        e = np.linalg.inv(e0) @ matrix(estimate[s])
-        r = np.linalg.inv(r0) @ matrix(reference[s])
-        err = np.linalg.inv(r) @ e
-        worst_t = max(worst_t, float(np.linalg.norm(err[:3, 3])))
-        worst_r = max(worst_r, rotation_angle(err[:3, :3]))
-    return worst_t, worst_r
 
 
 def parameter_overrides(config):
