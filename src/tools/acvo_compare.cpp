@@ -11,15 +11,12 @@
 // the per-run medians and their spread.
 #include <ctime>
 
-#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <functional>
 #include <iostream>
 #include <limits>
-#include <map>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -31,6 +28,8 @@
 #include "acvo/odometry/odometry.hpp"
 #include "acvo/params.hpp"
 #include "acvo/dataset/tum.hpp"
+#include "compare_methods.hpp"
+#include "compare_report.hpp"
 #include "peers.hpp"
 #include "tool_support.hpp"
 
@@ -147,20 +146,7 @@ std::optional<int> parseOptions(CLI::App& app, Options& o, int argc, char** argv
   return std::nullopt;
 }
 
-// One row of the table: a method at one setting over one dataset.
-struct Row {
-  std::string dataset, method, setting;
-  bool best = false;  // a <peer>_best row
-  acvo::Trajectory trajectory;
-  long lost = 0;
-  double offset = 0.0;  // s, added to the stamps against the reference's
-  bool offset_found = false;    // by --offset auto
-  std::string offset_refused;   // why --offset auto found none (then offset 0)
-  double rpe_trans = NAN, rpe_rot = NAN, ate = NAN;
-  // Per run: the median and 90th percentile over frames of the wall and CPU times (ms), and
-  // the median as a ratio of the best RgbdOdometry row's median in that run.
-  std::vector<double> median_ms, p90_ms, cpu_median_ms, ratio;
-};
+using Row = acvo::tools::CompareRow;
 
 Row makeRow(const std::string& dataset, const std::string& method, const std::string& setting) {
   Row row;
@@ -170,51 +156,10 @@ Row makeRow(const std::string& dataset, const std::string& method, const std::st
   return row;
 }
 
-// A method that registers frames one after the other: process() returns false when the frame
-// is lost; pose() is the camera pose after it.
-class Method {
- public:
-  virtual ~Method() = default;
-  virtual bool process(const acvo::Frame& frame) = 0;
-  virtual const Eigen::Isometry3d& pose() const = 0;
-  // Its poses are the depth camera's, at the depth images' stamps (a method of depth alone);
-  // otherwise at the colour images' (the stamps acvo's poses carry).
-  virtual bool depthOnly() const { return false; }
-};
-
-class AcvoMethod : public Method {
- public:
-  AcvoMethod(const acvo::Params& params, const Eigen::Isometry3d& start) : odometry_(params) {
-    odometry_.reset(start);
-  }
-  bool process(const acvo::Frame& frame) override {
-    const acvo::OdometryResult r = odometry_.process(frame);
-    return r.tracking != acvo::Tracking::kLost && r.tracking != acvo::Tracking::kBadFrame;
-  }
-  const Eigen::Isometry3d& pose() const override { return odometry_.pose(); }
-
- private:
-  acvo::Odometry odometry_;
-};
-
-class PeerMethod : public Method {
- public:
-  PeerMethod(const acvo::peers::PeerSetup& setup, const acvo::Camera& camera,
-             const Eigen::Isometry3d& start)
-      : peer_(setup, camera, start), depth_only_(setup.kind == acvo::peers::PeerKind::kIcp) {}
-  bool process(const acvo::Frame& frame) override { return peer_.process(frame); }
-  const Eigen::Isometry3d& pose() const override { return peer_.pose(); }
-  bool depthOnly() const override { return depth_only_; }
-
- private:
-  acvo::peers::PeerOdometry peer_;
-  bool depth_only_;
-};
-
 // What one row runs: its row and how to make a fresh method for each run.
 struct Entry {
   Row row;
-  std::function<std::unique_ptr<Method>()> make;
+  std::function<std::unique_ptr<acvo::tools::Method>()> make;
 };
 
 // The first pose: the ground truth nearest the first frame, identity without one.
@@ -228,11 +173,6 @@ std::string baseName(std::string path) {
   while (path.size() > 1 && path.back() == '/') path.pop_back();
   const auto slash = path.find_last_of('/');
   return slash == std::string::npos ? path : path.substr(slash + 1);
-}
-
-std::string threadsSetting(int threads) {
-  if (threads == 0) return "all_cores";
-  return std::to_string(threads) + (threads == 1 ? "_thread" : "_threads");
 }
 
 // "4m", "10m_guess": the maximum depth, and whether the last motion is the initial guess.
@@ -253,8 +193,8 @@ std::vector<Entry> entriesFor(const Options& opt, const acvo::Params& params,
       for (int threads : opt.threads) {
         acvo::Params p = params;
         p.odometry.threads = threads;
-        entries.push_back({makeRow(dataset, opt.label, threadsSetting(threads)),
-                           [p, start] { return std::make_unique<AcvoMethod>(p, start); }});
+        entries.push_back({makeRow(dataset, opt.label, acvo::tools::threadsSetting(threads)),
+                           [p, start] { return std::make_unique<acvo::tools::AcvoMethod>(p, start); }});
       }
       continue;
     }
@@ -267,7 +207,7 @@ std::vector<Entry> entriesFor(const Options& opt, const acvo::Params& params,
         const acvo::Camera camera = data.camera();
         entries.push_back({makeRow(dataset, method, peerSetting(max_depth, guess == "last")),
                            [setup, camera, start] {
-                             return std::make_unique<PeerMethod>(setup, camera, start);
+                             return std::make_unique<acvo::tools::PeerMethod>(setup, camera, start);
                            }});
       }
     }
@@ -286,7 +226,7 @@ double processCpuMs() {
 void runOnce(std::vector<Entry>& entries, const std::vector<acvo::Frame>& frames,
              const std::vector<std::size_t>& index, const acvo::TumDataset& data, bool record) {
   const std::size_t m = entries.size();
-  std::vector<std::unique_ptr<Method>> methods;
+  std::vector<std::unique_ptr<acvo::tools::Method>> methods;
   for (auto& e : entries) methods.push_back(e.make());
   std::vector<std::vector<double>> wall(m), cpu(m);
   for (std::size_t i = 0; i < frames.size(); ++i) {
@@ -334,119 +274,87 @@ void evaluate(Row& row, const acvo::TumDataset& data, double offset) {
   }
 }
 
-// Per OpenCV odometry, the index of its best row: the fewest lost frames, then the lowest sum
-// of the translation and rotation errors, each divided by its mean over the settings.
-std::map<std::string, std::size_t> bestRows(const std::vector<Entry>& entries,
-                                            const std::string& acvo_label) {
-  std::map<std::string, std::vector<std::size_t>> by_method;
-  for (std::size_t k = 0; k < entries.size(); ++k) {
-    if (entries[k].row.method != acvo_label) by_method[entries[k].row.method].push_back(k);
-  }
-  std::map<std::string, std::size_t> best;
-  for (const auto& [method, rows] : by_method) {
-    double mean_t = 0.0, mean_r = 0.0;
-    for (std::size_t k : rows) {
-      mean_t += entries[k].row.rpe_trans / double(rows.size());
-      mean_r += entries[k].row.rpe_rot / double(rows.size());
+// Every row evaluated at --offset, or at the offset found from all of them (--offset auto).
+void evaluateAll(const Options& opt, const acvo::TumDataset& data, const std::string& dataset,
+                 std::vector<Row>& rows, std::vector<std::string>& notes) {
+  double offset = opt.offset.value_or(0.0);
+  std::string refused;
+  if (!opt.offset && data.groundtruth()) {
+    std::vector<acvo::Trajectory> trajectories;
+    for (const auto& row : rows) trajectories.push_back(row.trajectory);
+    try {
+      offset = acvo::estimateClockOffset(*data.groundtruth(), trajectories).offset;
+      notes.push_back("# " + dataset + ": the frames' stamps " +
+                      acvo::tools::milliseconds(offset) + " against the reference's (--offset auto)");
+    } catch (const std::exception& e) {
+      refused = e.what();
+      notes.push_back("# " + dataset + ": evaluated at offset 0: " + refused);
     }
-    const auto worse = [&](std::size_t a, std::size_t b) {  // a is worse than b
-      const Row &ra = entries[a].row, &rb = entries[b].row;
-      if (ra.lost != rb.lost) return ra.lost > rb.lost;
-      const double sa = ra.rpe_trans / mean_t + ra.rpe_rot / mean_r;
-      const double sb = rb.rpe_trans / mean_t + rb.rpe_rot / mean_r;
-      return !(sa <= sb) && std::isfinite(sb);  // NaN (no ground truth) is never better
-    };
-    std::size_t chosen = rows.front();
-    for (std::size_t k : rows) {
-      if (worse(chosen, k)) chosen = k;
+  }
+  for (auto& row : rows) {
+    evaluate(row, data, offset);
+    row.offset_found = !opt.offset && refused.empty() && data.groundtruth();
+    row.offset_refused = refused;
+  }
+}
+
+// The rows of one folder, each peer's best setting after its last (where it has several), and
+// the notes to print below the table.
+void compareFolder(const Options& opt, const acvo::Params& params, const std::string& folder,
+                   std::vector<Row>& rows, std::vector<std::string>& notes) {
+  const acvo::TumDataset data(folder, opt.camera);
+  // The dataset's frames used: every stride-th, at most --frames of them.
+  std::vector<std::size_t> index;
+  for (std::size_t i = 0; i < data.size(); i += std::size_t(opt.stride)) {
+    if (opt.frames >= 0 && index.size() >= std::size_t(opt.frames)) break;
+    index.push_back(i);
+  }
+  std::vector<acvo::Frame> frames;
+  frames.reserve(index.size());
+  for (const std::size_t i : index) frames.push_back(data.loadFrame(i));
+  if (frames.empty()) throw std::runtime_error(folder + ": no frames");
+  const std::string dataset =
+      baseName(folder) + (opt.stride > 1 ? "_every" + std::to_string(opt.stride) : "");
+  std::vector<Entry> entries =
+      entriesFor(opt, params, data, dataset, startPose(data, frames.front().stamp));
+  for (int run = 0; run < opt.repeat; ++run) runOnce(entries, frames, index, data, run == 0);
+  std::vector<Row> folder_rows;
+  for (auto& e : entries) folder_rows.push_back(std::move(e.row));
+  evaluateAll(opt, data, dataset, folder_rows, notes);
+
+  // The best setting of each peer, and the speed ratio to the best RgbdOdometry, per run.
+  const auto best = acvo::tools::bestRows(folder_rows, opt.label);
+  const auto rgbd = best.find("rgbd");
+  for (auto& row : folder_rows) {
+    for (int run = 0; run < opt.repeat; ++run) {
+      row.ratio.push_back(rgbd == best.end()
+                              ? NAN
+                              : row.median_ms[std::size_t(run)] /
+                                    folder_rows[rgbd->second].median_ms[std::size_t(run)]);
     }
-    best[method] = chosen;
   }
-  return best;
-}
-
-std::string milliseconds(double seconds) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%+.1f ms", 1e3 * seconds);
-  return buf;
-}
-
-double median(std::vector<double> v) { return acvo::tools::percentile(std::move(v), 0.5); }
-
-// (max - min) / median of the runs' values, in percent; 0 for a single run.
-double spreadPercent(const std::vector<double>& v) {
-  if (v.size() < 2) return 0.0;
-  const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
-  const double m = median(v);
-  return m > 0.0 ? 100.0 * (*hi - *lo) / m : NAN;
-}
-
-std::string jsonNumber(double v) {
-  if (!std::isfinite(v)) return "null";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
-
-std::string jsonList(const std::vector<double>& v) {
-  std::string s = "[";
-  for (std::size_t k = 0; k < v.size(); ++k) s += (k ? ", " : "") + jsonNumber(v[k]);
-  return s + "]";
-}
-
-void printTable(const std::vector<Row>& rows, const Options& opt) {
-  std::string threads;
-  for (int t : opt.threads) threads += (threads.empty() ? "" : ",") + threadsSetting(t);
-  const std::string camera = opt.camera.empty() ? "" : "; camera: " + opt.camera;
-  const std::string offset =
-      opt.offset && *opt.offset != 0.0
-          ? "; the frames' stamps " + milliseconds(*opt.offset) + " against the reference's"
-          : "";
-  std::printf("# acvo on %s; OpenCV odometries serial, as OpenCV's TUM sample runs them (NaN "
-              "holes; _guess: the last motion as initial guess); times: median over frames, median of %d run%s interleaved "
-              "frame by frame; vs_rgbd: median time / the best RgbdOdometry setting's, per "
-              "run%s%s\n",
-              threads.c_str(), opt.repeat, opt.repeat == 1 ? "" : "s", camera.c_str(),
-              offset.c_str());
-  std::printf("%-20s %-12s %-12s %10s %11s %8s %5s %9s %8s %8s %8s\n", "dataset", "method",
-              "setting", "rpe_t_m/s", "rpe_r_deg/s", "ate_m", "lost", "median_ms", "cpu_ms",
-              "spread_%", "vs_rgbd");
-  for (const auto& r : rows) {
-    std::printf("%-20s %-12s %-12s %10.4f %11.3f %8.4f %5ld %9.2f %8.2f %8.1f %8.2f\n",
-                r.dataset.c_str(), r.method.c_str(), r.setting.c_str(), r.rpe_trans, r.rpe_rot,
-                r.ate, r.lost, median(r.median_ms), median(r.cpu_median_ms),
-                spreadPercent(r.median_ms), median(r.ratio));
+  for (std::size_t k = 0; k < folder_rows.size(); ++k) {
+    const Row& row = folder_rows[k];
+    if (!opt.trajectories.empty()) {
+      const bool plain = row.method == opt.label && opt.threads.size() == 1;
+      acvo::writeTrajectory(
+          opt.trajectories + "/" + dataset + "-" + row.method + (plain ? "" : "-" + row.setting) +
+              ".txt",
+          row.trajectory, row.method + " " + row.setting + " on " + folder);
+    }
+    rows.push_back(row);
+    // After a peer's last setting, its best one again, named as such.
+    const bool last_of_method =
+        k + 1 == folder_rows.size() || folder_rows[k + 1].method != row.method;
+    const auto b = best.find(row.method);
+    if (last_of_method && b != best.end() &&
+        opt.peer_max_depth.size() * opt.peer_guess.size() > 1) {
+      Row best_row = folder_rows[b->second];
+      best_row.method += "_best";
+      best_row.best = true;
+      rows.push_back(std::move(best_row));
+    }
   }
-}
-
-void writeJson(const std::vector<Row>& rows, const Options& opt) {
-  std::ofstream out(opt.json);
-  if (!out) throw std::runtime_error("cannot write " + opt.json);
-  out << "{\"rpe_delta_s\": 1, \"repeat\": " << opt.repeat;
-  if (!opt.camera.empty()) out << ", \"camera\": " << acvo::tools::jsonString(opt.camera);
-  out << ", \"acvo_threads\": [";
-  for (std::size_t k = 0; k < opt.threads.size(); ++k) out << (k ? ", " : "") << opt.threads[k];
-  out << "], \"runs\": [";
-  for (std::size_t k = 0; k < rows.size(); ++k) {
-    const Row& r = rows[k];
-    out << (k ? ",\n  " : "\n  ") << "{\"dataset\": " << acvo::tools::jsonString(r.dataset)
-        << ", \"method\": " << acvo::tools::jsonString(r.method)
-        << ", \"setting\": " << acvo::tools::jsonString(r.setting)
-        << ", \"best\": " << (r.best ? "true" : "false")
-        << ", \"frames\": " << r.trajectory.size() << ", \"rpe_trans\": " << jsonNumber(r.rpe_trans)
-        << ", \"rpe_rot_deg\": " << jsonNumber(r.rpe_rot) << ", \"ate\": " << jsonNumber(r.ate)
-        << ", \"lost\": " << r.lost << ", \"offset_s\": " << jsonNumber(r.offset)
-        << ", \"offset_found\": " << (r.offset_found ? "true" : "false") << ", \"offset_refused\": "
-        << (r.offset_refused.empty() ? "null" : acvo::tools::jsonString(r.offset_refused))
-        << ", \"median_ms\": " << jsonNumber(median(r.median_ms))
-        << ", \"p90_ms\": " << jsonNumber(median(r.p90_ms))
-        << ", \"cpu_median_ms\": " << jsonNumber(median(r.cpu_median_ms))
-        << ", \"median_ms_runs\": " << jsonList(r.median_ms)
-        << ", \"spread_percent\": " << jsonNumber(spreadPercent(r.median_ms))
-        << ", \"median_vs_rgbd\": " << jsonNumber(median(r.ratio))
-        << ", \"vs_rgbd_runs\": " << jsonList(r.ratio) << "}";
-  }
-  out << "\n]}\n";
 }
 
 }  // namespace
@@ -464,80 +372,11 @@ int main(int argc, char** argv) {
     }
     std::vector<Row> rows;
     std::vector<std::string> notes;  // printed below the table
-    for (const auto& folder : opt.datasets) {
-      const acvo::TumDataset data(folder, opt.camera);
-      // The dataset's frames used: every stride-th, at most --frames of them.
-      std::vector<std::size_t> index;
-      for (std::size_t i = 0; i < data.size(); i += std::size_t(opt.stride)) {
-        if (opt.frames >= 0 && index.size() >= std::size_t(opt.frames)) break;
-        index.push_back(i);
-      }
-      std::vector<acvo::Frame> frames;
-      frames.reserve(index.size());
-      for (const std::size_t i : index) frames.push_back(data.loadFrame(i));
-      if (frames.empty()) throw std::runtime_error(folder + ": no frames");
-      const std::string dataset =
-          baseName(folder) + (opt.stride > 1 ? "_every" + std::to_string(opt.stride) : "");
-      std::vector<Entry> entries =
-          entriesFor(opt, params, data, dataset, startPose(data, frames.front().stamp));
-      for (int run = 0; run < opt.repeat; ++run) runOnce(entries, frames, index, data, run == 0);
-      double offset = opt.offset.value_or(0.0);
-      std::string refused;
-      if (!opt.offset && data.groundtruth()) {
-        std::vector<acvo::Trajectory> trajectories;
-        for (const auto& e : entries) trajectories.push_back(e.row.trajectory);
-        try {
-          offset = acvo::estimateClockOffset(*data.groundtruth(), trajectories).offset;
-          notes.push_back("# " + dataset + ": the frames' stamps " + milliseconds(offset) +
-                          " against the reference's (--offset auto)");
-        } catch (const std::exception& e) {
-          refused = e.what();
-          notes.push_back("# " + dataset + ": evaluated at offset 0: " + refused);
-        }
-      }
-      for (auto& e : entries) {
-        evaluate(e.row, data, offset);
-        e.row.offset_found = !opt.offset && refused.empty() && data.groundtruth();
-        e.row.offset_refused = refused;
-      }
-
-      // The best setting of each peer, and the speed ratio to the best RgbdOdometry, per run.
-      const auto best = bestRows(entries, opt.label);
-      const auto rgbd = best.find("rgbd");
-      for (auto& e : entries) {
-        for (int run = 0; run < opt.repeat; ++run) {
-          e.row.ratio.push_back(rgbd == best.end()
-                                    ? NAN
-                                    : e.row.median_ms[std::size_t(run)] /
-                                          entries[rgbd->second].row.median_ms[std::size_t(run)]);
-        }
-      }
-      for (std::size_t k = 0; k < entries.size(); ++k) {
-        Row& row = entries[k].row;
-        if (!opt.trajectories.empty()) {
-          const bool plain = row.method == opt.label && opt.threads.size() == 1;
-          acvo::writeTrajectory(
-              opt.trajectories + "/" + dataset + "-" + row.method +
-                  (plain ? "" : "-" + row.setting) + ".txt",
-              row.trajectory, row.method + " " + row.setting + " on " + folder);
-        }
-        rows.push_back(row);
-        // After a peer's last setting, its best one again, named as such.
-        const bool last_of_method =
-            k + 1 == entries.size() || entries[k + 1].row.method != row.method;
-        const auto b = best.find(row.method);
-        if (last_of_method && b != best.end() &&
-            opt.peer_max_depth.size() * opt.peer_guess.size() > 1) {
-          Row best_row = entries[b->second].row;
-          best_row.method += "_best";
-          best_row.best = true;
-          rows.push_back(std::move(best_row));
-        }
-      }
-    }
-    printTable(rows, opt);
+    for (const auto& folder : opt.datasets) compareFolder(opt, params, folder, rows, notes);
+    const acvo::tools::CompareRun run{opt.threads, opt.repeat, opt.camera, opt.offset};
+    acvo::tools::printCompareTable(rows, run);
     for (const std::string& note : notes) std::printf("%s\n", note.c_str());
-    if (!opt.json.empty()) writeJson(rows, opt);
+    if (!opt.json.empty()) acvo::tools::writeCompareJson(rows, run, opt.json);
     return 0;
   } catch (const std::exception& e) {
     std::cerr << "acvo_compare: " << e.what() << "\n";
