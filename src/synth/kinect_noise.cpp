@@ -4,6 +4,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "synth/random.hpp"
@@ -37,6 +38,17 @@ cv::Mat correlatedField(cv::Size size, double length, std::uint64_t stream) {
 
 }  // namespace
 
+cv::Mat distortionField(cv::Size size, std::uint64_t seed) {
+  // Drawn at an eighth of the size, correlated over an eighth of that width (an eighth of the
+  // image's), then resized: the same smooth field at a fraction of the filtering's cost.
+  const cv::Size small((size.width + 7) / 8, (size.height + 7) / 8);
+  cv::Mat field = correlatedField(small, small.width / 8.0, seed);
+  cv::resize(field, field, size, 0.0, 0.0, cv::INTER_CUBIC);
+  cv::Scalar mean, stddev;
+  cv::meanStdDev(field, mean, stddev);
+  return (field - mean[0]) / stddev[0];
+}
+
 cv::Mat degradeDepth(const cv::Mat& exact, const KinectNoise& noise, double depth_scale,
                      std::uint64_t seed) {
   CV_Assert(exact.type() == CV_32FC1);
@@ -52,9 +64,13 @@ cv::Mat degradeDepth(const cv::Mat& exact, const KinectNoise& noise, double dept
       noise.correlation_px > 0.0
           ? correlatedField(exact.size(), noise.correlation_px, hashCombine(seed, kFieldStream))
           : cv::Mat();
+  const cv::Mat distortion = noise.distortion_relative > 0.0
+                                 ? distortionField(exact.size(), noise.distortion_seed)
+                                 : cv::Mat();
   tbb::parallel_for(tbb::blocked_range<int>(0, exact.rows), [&](const tbb::blocked_range<int>& r) {
     for (int v = r.begin(); v < r.end(); ++v) {
       Rng rng(hashCombine(stream, v));
+      const float* distorted = distortion.empty() ? nullptr : distortion.ptr<float>(v);
       const float* in = exact.ptr<float>(v);
       const float* lo = lowest.ptr<float>(v);
       const float* hi = highest.ptr<float>(v);
@@ -68,6 +84,7 @@ cv::Mat degradeDepth(const cv::Mat& exact, const KinectNoise& noise, double dept
         const double jump = noise.edge_jump_base + noise.edge_jump_quadratic * z * z;
         if (!(lo[u] > 0.0f) || hi[u] - z > jump || z - lo[u] > jump) continue;
         double measured = z + noise.depthSigma(z) * gaussian;
+        if (distorted) measured *= 1.0 + noise.distortion_relative * distorted[u];
         if (measured <= 0.0) continue;
         if (noise.disparity_step > 0.0) {
           const double steps = std::round(noise.focal_baseline / measured / noise.disparity_step);

@@ -12,6 +12,12 @@
 // field is white noise smoothed by a Gaussian of correlation_px pixels, then scaled back to unit
 // variance: neighbours d pixels apart correlate by exp(-d^2 / (4 correlation_px^2))).
 //
+// A sensor's fixed depth distortion (distortion_relative > 0): every frame's depth is scaled by
+// 1 + distortion_relative D(u, v), D a smooth unit-variance field fixed to the image (drawn once
+// from distortion_seed, correlated over an eighth of the image's width), as a structured-light
+// sensor's calibration leaves a pattern of a few per mille that stays where it is in the image
+// while the scene moves through it.
+//
 // The random numbers of row v come from hashCombine(seed, v): results are identical for
 // any thread count.
 #pragma once
@@ -36,6 +42,8 @@ struct KinectNoise {
   double edge_jump_quadratic = 0.01;  // 1/m
   double colour_sigma = 1.5;          // 8-bit grey levels
   double correlation_px = 0.0;        // px; the depth noise's correlation length (0: per pixel)
+  double distortion_relative = 0.0;   // the fixed distortion's standard deviation (0: none)
+  std::uint64_t distortion_seed = 0;  // the sensor's: the same for every frame
 
   double depthSigma(double z) const {
     const double e = z - sigma_offset;
@@ -47,6 +55,9 @@ struct KinectNoise {
 // 1 / depth_scale metres when depth_scale > 1 (integer depth images).
 cv::Mat degradeDepth(const cv::Mat& exact, const KinectNoise& noise, double depth_scale,
                      std::uint64_t seed);
+
+// The fixed distortion's field D for an image of this size (unit variance, smooth).
+cv::Mat distortionField(cv::Size size, std::uint64_t seed);
 
 // colour: CV_32FC3, modified in place (not clamped: the 8-bit conversion saturates).
 void addColourNoise(cv::Mat& colour, double sigma, std::uint64_t seed);

@@ -40,6 +40,8 @@ const SequenceOptions& validated(const SequenceOptions& o) {
     throw std::invalid_argument("depth_noise_correlation must be within [0, 50] pixels");
   if (!(o.walker_speed >= 0 && o.walker_speed <= 5))
     throw std::invalid_argument("walker_speed must be within [0, 5] m/s");
+  if (!(o.depth_distortion >= 0 && o.depth_distortion <= 0.05))
+    throw std::invalid_argument("depth_distortion must be within [0, 0.05]");
   if (o.walker_speed > 0 && !o.structure)
     throw std::invalid_argument("a walker needs the furnished room (structure on)");
   return o;
@@ -62,6 +64,7 @@ std::string describe(const SequenceOptions& o) {
   if (o.noise && o.depth_noise_correlation > 0.0) {
     s << ", depth noise correlated over " << o.depth_noise_correlation << " px";
   }
+  if (o.noise && o.depth_distortion > 0.0) s << ", depth distorted by " << o.depth_distortion;
   if (o.walker_speed > 0.0) s << ", a person walking across at " << o.walker_speed << " m/s";
   return s.str();
 }
@@ -96,6 +99,8 @@ RenderOptions SequenceOptions::renderOptions() const {
   r.colour_baseline = colour_baseline;
   r.vignetting = vignetting;
   r.kinect.correlation_px = depth_noise_correlation;
+  r.kinect.distortion_relative = depth_distortion;
+  r.kinect.distortion_seed = hashCombine(seed, 17);
   return r;
 }
 

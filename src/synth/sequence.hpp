@@ -49,6 +49,9 @@ struct SequenceOptions {
   // The depth noise's correlation length in pixels (KinectNoise::correlation_px; 0 = each
   // pixel's own).
   double depth_noise_correlation = 0.0;
+  // The sensor's fixed depth distortion (KinectNoise::distortion_relative; 0 = none), drawn
+  // from the seed.
+  double depth_distortion = 0.0;
   // A person walking back and forth across the view at this speed (m/s; walkerAt in
   // scene.hpp); 0 = none, the room standing still. A blurred frame (blur) sees the person
   // where it stands at the frame's time: only the camera's motion blurs.
@@ -71,7 +74,8 @@ class SynthSequence {
   // invalid camera, blur_samples < 1, exposure outside [0, 1], colour_focal_ratio outside
   // [0.5, 2], colour_baseline not within 1 m, colour_delay not under half a frame interval,
   // brightness_swing outside [0, 0.9], vignetting outside [-3, 0], depth_noise_correlation
-  // outside [0, 50], walker_speed outside [0, 5] or with structure off).
+  // outside [0, 50], depth_distortion outside [0, 0.05], walker_speed outside [0, 5] or with
+  // structure off).
   explicit SynthSequence(const SequenceOptions& options);
 
   int size() const { return options_.frames; }

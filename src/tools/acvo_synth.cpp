@@ -113,6 +113,13 @@ int main(int argc, char** argv) {
       ->type_name("PX")
       ->capture_default_str()
       ->transform(acvo::tools::numberIn(0.0, 50.0, "within [0, 50] pixels"));
+  app.add_option("--depth-distortion", o.depth_distortion,
+                 "a sensor's fixed depth distortion: every frame's depth scaled by 1 + R D(u,v), "
+                 "D a smooth unit field fixed to the image (a few per mille: an uncalibrated "
+                 "structured-light sensor); 0: none")
+      ->type_name("R")
+      ->capture_default_str()
+      ->transform(acvo::tools::numberIn(0.0, 0.05, "within [0, 0.05]"));
   app.add_option("--walker", o.walker_speed,
                  "a person (a box of a person's size, 1.2 m in front of the start) walking back "
                  "and forth across the view at this speed, the scene's one moving object, as in "

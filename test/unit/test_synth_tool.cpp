@@ -319,6 +319,22 @@ TEST(SynthTool, DepthNoiseCorrelationChangesTheDepthAlone) {
   }
 }
 
+// A fixed depth distortion (--depth-distortion R) changes the depth images alone, and says so.
+TEST(SynthTool, DepthDistortionChangesTheDepthAlone) {
+  const fs::path a = test::tempDir("synth_tool_undistorted"),
+                 b = test::tempDir("synth_tool_distorted");
+  const std::string common = " --frames 2 --width 96 --height 72 --seed 4";
+  ASSERT_EQ(runTool("'" + a.string() + "'" + common), 0);
+  ASSERT_EQ(runTool("'" + b.string() + "'" + common + " --depth-distortion 0.01"), 0);
+  EXPECT_NE(readBytes(b / "rgb.txt").find("depth distorted by 0.01"), std::string::npos);
+  for (const auto& row : readRows(a / "rgb.txt")) {
+    EXPECT_EQ(readBytes(a / row[1]), readBytes(b / row[1]));
+  }
+  for (const auto& row : readRows(a / "depth.txt")) {
+    EXPECT_NE(readBytes(a / row[1]), readBytes(b / row[1]));
+  }
+}
+
 // Mean absolute difference of two 8-bit colour images.
 double meanDifference(const fs::path& a, const fs::path& b) {
   const cv::Mat x = cv::imread(a.string()), y = cv::imread(b.string());
@@ -508,6 +524,8 @@ TEST(SynthTool, HelpAndBadOptions) {
   EXPECT_EQ(runTool(out + " --vignetting 0.5"), 2);
   EXPECT_EQ(runTool(out + " --depth-noise-correlation -1"), 2);
   EXPECT_EQ(runTool(out + " --depth-noise-correlation 60"), 2);
+  EXPECT_EQ(runTool(out + " --depth-distortion -0.01"), 2);
+  EXPECT_EQ(runTool(out + " --depth-distortion 0.06"), 2);
   EXPECT_EQ(runTool(out + " --walker -1"), 2);
   EXPECT_EQ(runTool(out + " --walker 1 --structure off"), 2);  // nothing to walk through
   EXPECT_EQ(runTool(out + " --colour red"), 2);  // unknown option
