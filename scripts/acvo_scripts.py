@@ -236,7 +236,8 @@ def load_average():
 
 def machine_info(load_averages=1):
     """nproc, CPU model, load, date and commit (short hash, "-dirty" when the tree has
-    changes). load: the first `load_averages` of the 1, 5 and 15-minute figures (scripts/bench
+    changes besides the documents, *.md and docs/, which the figures do not depend on and the
+    scripts write). load: the first `load_averages` of the 1, 5 and 15-minute figures (scripts/bench
     records the 1-minute one; the nodelet scripts, whose runs last minutes, all three)."""
     model = "unknown"
     try:
@@ -252,7 +253,7 @@ def machine_info(load_averages=1):
     except OSError:
         load = "?"
     commit = git("rev-parse", "--short", "HEAD") or "unknown"
-    if git("status", "--porcelain"):
+    if git("status", "--porcelain", "--", ".", ":(exclude)*.md", ":(exclude)docs/"):
         commit += "-dirty"
     return {
         "nproc": len(os.sched_getaffinity(0)),
