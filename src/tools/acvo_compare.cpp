@@ -25,9 +25,9 @@
 #include <vector>
 
 #include "acvo/dataset/evaluation.hpp"
+#include "acvo/dataset/tum.hpp"
 #include "acvo/odometry/odometry.hpp"
 #include "acvo/params.hpp"
-#include "acvo/dataset/tum.hpp"
 #include "compare_methods.hpp"
 #include "compare_report.hpp"
 #include "peers.hpp"
@@ -193,8 +193,9 @@ std::vector<Entry> entriesFor(const Options& opt, const acvo::Params& params,
       for (int threads : opt.threads) {
         acvo::Params p = params;
         p.odometry.threads = threads;
-        entries.push_back({makeRow(dataset, opt.label, acvo::tools::threadsSetting(threads)),
-                           [p, start] { return std::make_unique<acvo::tools::AcvoMethod>(p, start); }});
+        entries.push_back(
+            {makeRow(dataset, opt.label, acvo::tools::threadsSetting(threads)),
+             [p, start] { return std::make_unique<acvo::tools::AcvoMethod>(p, start); }});
       }
       continue;
     }
@@ -284,8 +285,8 @@ void evaluateAll(const Options& opt, const acvo::TumDataset& data, const std::st
     for (const auto& row : rows) trajectories.push_back(row.trajectory);
     try {
       offset = acvo::estimateClockOffset(*data.groundtruth(), trajectories).offset;
-      notes.push_back("# " + dataset + ": the frames' stamps " +
-                      acvo::tools::milliseconds(offset) + " against the reference's (--offset auto)");
+      notes.push_back("# " + dataset + ": the frames' stamps " + acvo::tools::milliseconds(offset) +
+                      " against the reference's (--offset auto)");
     } catch (const std::exception& e) {
       refused = e.what();
       notes.push_back("# " + dataset + ": evaluated at offset 0: " + refused);
@@ -337,10 +338,9 @@ void compareFolder(const Options& opt, const acvo::Params& params, const std::st
     const Row& row = folder_rows[k];
     if (!opt.trajectories.empty()) {
       const bool plain = row.method == opt.label && opt.threads.size() == 1;
-      acvo::writeTrajectory(
-          opt.trajectories + "/" + dataset + "-" + row.method + (plain ? "" : "-" + row.setting) +
-              ".txt",
-          row.trajectory, row.method + " " + row.setting + " on " + folder);
+      acvo::writeTrajectory(opt.trajectories + "/" + dataset + "-" + row.method +
+                                (plain ? "" : "-" + row.setting) + ".txt",
+                            row.trajectory, row.method + " " + row.setting + " on " + folder);
     }
     rows.push_back(row);
     // After a peer's last setting, its best one again, named as such.

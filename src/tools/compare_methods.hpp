@@ -38,8 +38,7 @@ class AcvoMethod : public Method {
 
 class PeerMethod : public Method {
  public:
-  PeerMethod(const peers::PeerSetup& setup, const Camera& camera,
-             const Eigen::Isometry3d& start)
+  PeerMethod(const peers::PeerSetup& setup, const Camera& camera, const Eigen::Isometry3d& start)
       : peer_(setup, camera, start), depth_only_(setup.kind == peers::PeerKind::kIcp) {}
   bool process(const Frame& frame) override { return peer_.process(frame); }
   const Eigen::Isometry3d& pose() const override { return peer_.pose(); }

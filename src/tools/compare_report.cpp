@@ -11,7 +11,9 @@
 namespace acvo::tools {
 namespace {
 
-double median(std::vector<double> v) { return percentile(std::move(v), 0.5); }
+double median(std::vector<double> v) {
+  return percentile(std::move(v), 0.5);
+}
 
 // (max - min) / median of the runs' values, in percent; 0 for a single run.
 double spreadPercent(const std::vector<double>& v) {
@@ -84,12 +86,12 @@ void printCompareTable(const std::vector<CompareRow>& rows, const CompareRun& ru
       run.offset && *run.offset != 0.0
           ? "; the frames' stamps " + milliseconds(*run.offset) + " against the reference's"
           : "";
-  std::printf("# acvo on %s; OpenCV odometries serial, as OpenCV's TUM sample runs them (NaN "
-              "holes; _guess: the last motion as initial guess); times: median over frames, "
-              "median of %d run%s interleaved frame by frame; vs_rgbd: median time / the best "
-              "RgbdOdometry setting's, per run%s%s\n",
-              threads.c_str(), run.repeat, run.repeat == 1 ? "" : "s", camera.c_str(),
-              offset.c_str());
+  std::printf(
+      "# acvo on %s; OpenCV odometries serial, as OpenCV's TUM sample runs them (NaN "
+      "holes; _guess: the last motion as initial guess); times: median over frames, "
+      "median of %d run%s interleaved frame by frame; vs_rgbd: median time / the best "
+      "RgbdOdometry setting's, per run%s%s\n",
+      threads.c_str(), run.repeat, run.repeat == 1 ? "" : "s", camera.c_str(), offset.c_str());
   std::printf("%-20s %-12s %-12s %10s %11s %8s %5s %9s %8s %8s %8s\n", "dataset", "method",
               "setting", "rpe_t_m/s", "rpe_r_deg/s", "ate_m", "lost", "median_ms", "cpu_ms",
               "spread_%", "vs_rgbd");
@@ -114,8 +116,8 @@ void writeCompareJson(const std::vector<CompareRow>& rows, const CompareRun& run
     const CompareRow& r = rows[k];
     out << (k ? ",\n  " : "\n  ") << "{\"dataset\": " << jsonString(r.dataset)
         << ", \"method\": " << jsonString(r.method) << ", \"setting\": " << jsonString(r.setting)
-        << ", \"best\": " << (r.best ? "true" : "false")
-        << ", \"frames\": " << r.trajectory.size() << ", \"rpe_trans\": " << jsonNumber(r.rpe_trans)
+        << ", \"best\": " << (r.best ? "true" : "false") << ", \"frames\": " << r.trajectory.size()
+        << ", \"rpe_trans\": " << jsonNumber(r.rpe_trans)
         << ", \"rpe_rot_deg\": " << jsonNumber(r.rpe_rot) << ", \"ate\": " << jsonNumber(r.ate)
         << ", \"lost\": " << r.lost << ", \"offset_s\": " << jsonNumber(r.offset)
         << ", \"offset_found\": " << (r.offset_found ? "true" : "false") << ", \"offset_refused\": "

@@ -18,9 +18,9 @@ struct CompareRow {
   bool best = false;  // a <peer>_best row
   Trajectory trajectory;
   long lost = 0;
-  double offset = 0.0;          // s, added to the stamps against the reference's
-  bool offset_found = false;    // by --offset auto
-  std::string offset_refused;   // why --offset auto found none (then offset 0)
+  double offset = 0.0;         // s, added to the stamps against the reference's
+  bool offset_found = false;   // by --offset auto
+  std::string offset_refused;  // why --offset auto found none (then offset 0)
   double rpe_trans = NAN, rpe_rot = NAN, ate = NAN;
   // Per run: the median and 90th percentile over frames of the wall and CPU times (ms), and
   // the median as a ratio of the best RgbdOdometry row's median in that run.
@@ -29,10 +29,10 @@ struct CompareRow {
 
 // What the table's first line and the JSON's header say of the run.
 struct CompareRun {
-  std::vector<int> threads;       // acvo's, one row per value
+  std::vector<int> threads;  // acvo's, one row per value
   int repeat = 1;
-  std::string camera;             // --camera, empty: each folder's own
-  std::optional<double> offset;   // --offset, empty: auto
+  std::string camera;            // --camera, empty: each folder's own
+  std::optional<double> offset;  // --offset, empty: auto
 };
 
 // "1_thread", "2_threads", "all_cores" (0).
