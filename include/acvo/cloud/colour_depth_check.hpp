@@ -24,7 +24,9 @@
 // same in all quarters of the image but one (min_quarter_gain: a person's colour late on its
 // silhouette fits a camera in one part of the image only); most frames' own best camera near
 // it (min_agreement); and the focal ratio alone that fits best near it (the default
-// resampling's, best_ratio) also min_offset from 1 and not at the grid's ends. Colour and depth
+// resampling's, best_ratio) also min_offset from 1 and not at the grid's ends. Before
+// frames_needed, only a clear "unregistered" is given (early_frames): every frame's own best
+// camera near the one found and the gains well above the last rule's. Colour and depth
 // of two instants (free-running streams) misalign by the motion between them: Odometry, which
 // runs the check, gives it the depth as it registered it (depthAsRegistered, odometry.hpp), and
 // resamples an unregistered camera's colour by the ratio found (withColourResampled, below).
@@ -55,8 +57,9 @@ class ColourDepthCheck {
   static constexpr int kGridEnd = 4;
   static bool atGridEnd(int i);
   // Odometry gives it every kFrameStep-th frame until it decides. Every frame: the verdict
-  // comes at the tenth frame with enough depth edges, so that colour from a second camera is
-  // resampled (withColourResampled) from the first third of a second on. A frame looked at
+  // comes at the tenth frame with enough depth edges, or at the third where the evidence is
+  // clear (early_frames: 7-Scenes' kitchen, 2.1x), so that colour from a second camera is
+  // resampled (withColourResampled) from the first tenth or third of a second on. A frame looked at
   // costs about as much as registering one (the grid of 41 x 13 cameras on its thinned edge
   // pixels, up to 2000 of them), on those first frames only.
   static constexpr int kFrameStep = 1;
@@ -64,7 +67,10 @@ class ColourDepthCheck {
   struct Options {
     double depth_jump = 0.05;      // a depth edge: a pixel within 3 px is farther by this x z
     int min_edge_pixels = 500;     // a frame with fewer depth-edge pixels does not count
-    int frames_needed = 10;        // counted frames before a verdict
+    int frames_needed = 10;        // counted frames before a verdict, but ...
+    int early_frames = 3;          // ... "unregistered" from this many on where every frame's
+    double early_gain = 1.5;       // own best camera agrees with the one found and its gains
+    double early_quarter_gain = 1.3;  // reach these (min_gain, min_quarter_gain: the last rule)
     double min_gain = 1.15;        // unregistered: the best camera's score over ratio 1's ...
     double min_offset = 0.04;      // ... its ratio, and the ratio alone, this far from 1 ...
     double min_quarter_gain = 1.1;  // ... and this gain in all quarters of the image but one ...
@@ -127,7 +133,9 @@ class ColourDepthCheck {
   // score() at every ratio of the grid, without a baseline.
   static std::array<double, kRatios> ratioScores(const cv::Mat& strength, const Camera& camera,
                                                  const std::vector<EdgePoint>& edges);
-  void decide();
+  // The verdict on the evidence so far; before frames_needed (final false) "unregistered" alone,
+  // on the early rule, and otherwise undecided still.
+  void decide(bool final);
   // The image's quarter of an edge pixel about the principal point (0-3), and the sums and counts
   // of score() by quarter.
   struct Quarters {

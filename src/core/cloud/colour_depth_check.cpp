@@ -187,7 +187,7 @@ const ColourDepthCheck::Verdict& ColourDepthCheck::add(const Frame& frame) {
     ++quarter_edges_[std::size_t(quarterOf(frame.camera, e))];
   }
   frame_camera_best_.push_back(frame_best);
-  if (verdict_.frames >= options_.frames_needed) decide();
+  if (verdict_.frames >= options_.early_frames) decide(verdict_.frames >= options_.frames_needed);
   return verdict_;
 }
 
@@ -208,7 +208,7 @@ std::size_t ColourDepthCheck::cameraIndex(int i, int j) const {
   return std::size_t(i) * std::size_t(baselines()) + std::size_t(j);
 }
 
-void ColourDepthCheck::decide() {
+void ColourDepthCheck::decide(bool final) {
   const int one = kRatios / 2;  // ratio 1.00
   // Options in ratios, as whole steps of the ratio grid.
   auto steps = [](double ratio) { return int(std::lround(ratio / kRatioStep)); };
@@ -244,13 +244,23 @@ void ColourDepthCheck::decide() {
   const auto near_first = sum_.begin() + std::max(0, best - within);
   const auto near_last = sum_.begin() + std::min(kRatios, best + within + 1);
   const int alone = int(std::max_element(near_first, near_last) - sum_.begin());
-  const bool unregistered = !atGridEnd(best) && !atGridEnd(alone) &&
-                            std::abs(best - one) >= offset && std::abs(alone - one) >= offset &&
-                            verdict_.gain >= options_.min_gain &&
+  verdict_.best_ratio = ratioAt(alone);
+  const bool a_camera = !atGridEnd(best) && !atGridEnd(alone) && std::abs(best - one) >= offset &&
+                        std::abs(alone - one) >= offset;
+  // Before frames_needed, "unregistered" on evidence that more frames would not overturn: every
+  // frame's own best camera near the one found, and gains well beyond the final rule's. Each
+  // frame before the verdict is registered with its colour where the other camera put it.
+  if (!final) {
+    if (a_camera && verdict_.agreement >= 1.0 && verdict_.gain >= options_.early_gain &&
+        verdict_.quarter_gain >= options_.early_quarter_gain) {
+      verdict_.state = State::kUnregistered;
+    }
+    return;
+  }
+  const bool unregistered = a_camera && verdict_.gain >= options_.min_gain &&
                             verdict_.agreement >= options_.min_agreement &&
                             verdict_.quarter_gain >= options_.min_quarter_gain;
   verdict_.state = unregistered ? State::kUnregistered : State::kRegistered;
-  verdict_.best_ratio = ratioAt(alone);
 }
 
 std::string ColourDepthCheck::describe() const {
