@@ -129,7 +129,8 @@ TEST(Sequences, DepthNoiseInBlobsAsARealKinectsCostsLittle) {
 
 // Colour from a second camera, as 7-Scenes' (a Kinect's raw depth paired with its colour): 0.897
 // times the depth camera's focal length, 2.5 cm beside it, the depth's noise in blobs. Once the
-// colour check judges it unregistered (the tenth frame), each frame's colour is resampled to
+// colour check judges it unregistered (the tenth frame: 1.4x, short of the early verdict's
+// 1.5x), each frame's colour is resampled to
 // the depth camera by the focal ratio it found, the photometric term is left out (the
 // baseline's offset remains) and the last level is led by the depth; as it came, the points
 // chosen at the colour's edges sit where the texture appears, which slides along the surfaces
@@ -153,11 +154,11 @@ TEST(Sequences, ColourFromASecondCameraIsResampledToTheDepthCamera) {
       runs[0].rpe.trans.rmse, runs[0].rpe.rot_deg.rmse, runs[1].rpe.trans.rmse,
       runs[1].rpe.rot_deg.rmse);
   for (const auto& run : runs) EXPECT_EQ(run.lost, 0);
-  // Measured 0.00695 m/s, 0.2317 deg/s resampled, 0.02319, 0.5195 as it came (with the colour
+  // Measured 0.00701 m/s, 0.2303 deg/s resampled, 0.02311, 0.5356 as it came (with the colour
   // registered before the first frame, 0.0047 / 0.036: most of the rotation error is the first
   // ten frames').
-  EXPECT_LT(runs[0].rpe.trans.rmse, 1.3 * 0.00695);
-  EXPECT_LT(runs[0].rpe.rot_deg.rmse, 1.3 * 0.2317);
+  EXPECT_LT(runs[0].rpe.trans.rmse, 1.3 * 0.00701);
+  EXPECT_LT(runs[0].rpe.rot_deg.rmse, 1.3 * 0.2303);
   EXPECT_GT(runs[1].rpe.trans.rmse, 3.0 * runs[0].rpe.trans.rmse);
   EXPECT_GT(runs[1].rpe.rot_deg.rmse, 1.8 * runs[0].rpe.rot_deg.rmse);
 }
