@@ -71,10 +71,8 @@ struct Options {
   std::optional<double> offset = 0.0;  // empty: estimated per dataset (--offset auto)
 };
 
-// The command line into `o`; nullopt to go on, else the exit status.
-std::optional<int> parseOptions(CLI::App& app, Options& o, int argc, char** argv) {
-  acvo::tools::setUpCommandLine(app, kFooter);
-  app.add_option("DATASET_DIR", o.datasets, "TUM RGB-D folders")->type_name("")->required();
+// Which methods run, in which settings (each a row), and how often.
+void addMethodOptions(CLI::App& app, Options& o) {
   app.add_option("--methods", o.methods, "comma-separated subset of acvo,rgbd,icp,rgbd_icp")
       ->type_name("LIST")
       ->delimiter(',')
@@ -109,6 +107,10 @@ std::optional<int> parseOptions(CLI::App& app, Options& o, int argc, char** argv
       ->allow_extra_args(false)
       ->default_str("none,last")
       ->check(CLI::IsMember({"none", "last"}).description(""));
+}
+
+// The frames each method is given, acvo's parameters and what is written.
+void addInputOptions(CLI::App& app, Options& o) {
   app.add_option("--camera", o.camera,
                  "every method's intrinsics, and a lens distortion the frames are undistorted by "
                  "(default: each DATASET_DIR/camera.yaml, else default)")
@@ -137,6 +139,14 @@ std::optional<int> parseOptions(CLI::App& app, Options& o, int argc, char** argv
   app.add_option("--trajectories", o.trajectories,
                  "write each estimate as DIR/<dataset>-<method>[-<setting>].txt")
       ->type_name("DIR");
+}
+
+// The command line into `o`; nullopt to go on, else the exit status.
+std::optional<int> parseOptions(CLI::App& app, Options& o, int argc, char** argv) {
+  acvo::tools::setUpCommandLine(app, kFooter);
+  app.add_option("DATASET_DIR", o.datasets, "TUM RGB-D folders")->type_name("")->required();
+  addMethodOptions(app, o);
+  addInputOptions(app, o);
   if (const auto status = acvo::tools::parseCommandLine(app, argc, argv)) return status;
   // --methods "" or ",": CLI11 leaves the list empty.
   if (o.methods.empty()) return acvo::tools::usageError(app, "--methods is empty");

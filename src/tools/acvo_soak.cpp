@@ -139,36 +139,16 @@ double slope(const std::vector<double>& x, const std::vector<double>& y) {
   return sxx > 0 ? sxy / sxx : 0.0;
 }
 
-int run(const Arguments& args) {
-  acvo::synth::SequenceOptions o;
-  o.frames = args.frames;
-  o.seed = args.seed;
-  o.camera = acvo::synth::scaledDefaultCamera(args.width, args.height);
-  const acvo::synth::SynthSequence sequence(o);
-  const int blackout_frames = static_cast<int>(std::lround(o.rate));  // 1 s
-
-  std::printf("acvo_soak: %d frames %dx%d at %g Hz, faults every %d frames\n", args.frames,
-              args.width, args.height, o.rate, args.fault_every);
-  acvo::Odometry odometry;
-  constexpr int kWarmup = 1000, kReportEvery = 1000, kSampleEvery = 100;
-  std::vector<double> ms, rss_frame, rss_kib;
-  ms.reserve(args.frames);
+// What the soak saw, frame by frame.
+struct Tally {
+  static constexpr int kWarmup = 1000, kReportEvery = 1000, kSampleEvery = 100;
+  std::vector<double> ms, rss_frame, rss_kib;  // time per frame; RSS samples after warm-up
   int counts[5] = {}, lost_on_faults = 0, fault_frames = 0;
   double max_translation = 0.0;
   bool all_finite = true;
-  const long rss_start = acvo::tools::residentKiB();
-  double previous_stamp = 0.0;
 
-  for (int i = 0; i < args.frames; ++i) {
-    const Fault fault = faultAt(i, args.fault_every, blackout_frames);
-    const acvo::Frame frame = inject(sequence.frame(i).toFrame(), fault, previous_stamp);
-    previous_stamp = frame.stamp;
-
-    const auto t0 = std::chrono::steady_clock::now();
-    const acvo::OdometryResult r = odometry.process(frame);
-    ms.push_back(
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-
+  void add(int i, Fault fault, const acvo::OdometryResult& r, double frame_ms) {
+    ms.push_back(frame_ms);
     ++counts[static_cast<int>(r.tracking)];
     if (fault != Fault::kNone) {
       ++fault_frames;
@@ -180,7 +160,6 @@ int run(const Arguments& args) {
     } else {
       max_translation = std::max(max_translation, r.pose.translation().norm());
     }
-
     const int done = i + 1;
     if (done % kSampleEvery == 0 && done >= kWarmup) {
       rss_frame.push_back(done);
@@ -195,29 +174,60 @@ int run(const Arguments& args) {
     }
   }
 
-  const long rss_end = acvo::tools::residentKiB();
-  std::printf("\nframes processed: %d (%d carried a fault)\n", args.frames, fault_frames);
-  std::printf("tracking: ok %d, hard %d, lost %d (%d of them on fault frames), first %d, bad %d\n",
-              counts[int(acvo::Tracking::kOk)], counts[int(acvo::Tracking::kHard)],
-              counts[int(acvo::Tracking::kLost)], lost_on_faults,
-              counts[int(acvo::Tracking::kFirstFrame)], counts[int(acvo::Tracking::kBadFrame)]);
-  // The samples above are taken with a frame's images alive; these two between frames.
-  std::printf("RSS: %ld KiB before the first frame, %ld KiB after the last\n", rss_start, rss_end);
-  if (rss_kib.size() >= 2) {
+  // rss_start and rss_end are taken between frames, the samples with a frame's images alive.
+  void print(int frames, long rss_start, long rss_end) const {
+    std::printf("\nframes processed: %d (%d carried a fault)\n", frames, fault_frames);
     std::printf(
-        "RSS growth after %d frames of warm-up: %.1f KiB per 1000 frames (fit over %zu "
-        "samples, frames %.0f-%.0f)\n",
-        kWarmup, 1000.0 * slope(rss_frame, rss_kib), rss_kib.size(), rss_frame.front(),
-        rss_frame.back());
-  } else {
-    std::printf("RSS growth: n/a (needs more than %d frames)\n", kWarmup + kSampleEvery);
+        "tracking: ok %d, hard %d, lost %d (%d of them on fault frames), first %d, bad %d\n",
+        counts[int(acvo::Tracking::kOk)], counts[int(acvo::Tracking::kHard)],
+        counts[int(acvo::Tracking::kLost)], lost_on_faults,
+        counts[int(acvo::Tracking::kFirstFrame)], counts[int(acvo::Tracking::kBadFrame)]);
+    std::printf("RSS: %ld KiB before the first frame, %ld KiB after the last\n", rss_start,
+                rss_end);
+    if (rss_kib.size() >= 2) {
+      std::printf(
+          "RSS growth after %d frames of warm-up: %.1f KiB per 1000 frames (fit over %zu "
+          "samples, frames %.0f-%.0f)\n",
+          kWarmup, 1000.0 * slope(rss_frame, rss_kib), rss_kib.size(), rss_frame.front(),
+          rss_frame.back());
+    } else {
+      std::printf("RSS growth: n/a (needs more than %d frames)\n", kWarmup + kSampleEvery);
+    }
+    std::printf("Odometry::process: median %.1f ms, p90 %.1f ms, max %.1f ms per frame\n",
+                acvo::tools::percentile(ms, 0.5), acvo::tools::percentile(ms, 0.9),
+                *std::max_element(ms.begin(), ms.end()));
+    std::printf("max |pose translation|: %.3f m; all poses finite: %s\n", max_translation,
+                all_finite ? "yes" : "NO");
   }
-  std::printf("Odometry::process: median %.1f ms, p90 %.1f ms, max %.1f ms per frame\n",
-              acvo::tools::percentile(ms, 0.5), acvo::tools::percentile(ms, 0.9),
-              *std::max_element(ms.begin(), ms.end()));
-  std::printf("max |pose translation|: %.3f m; all poses finite: %s\n", max_translation,
-              all_finite ? "yes" : "NO");
-  return all_finite ? 0 : 1;
+};
+
+int run(const Arguments& args) {
+  acvo::synth::SequenceOptions o;
+  o.frames = args.frames;
+  o.seed = args.seed;
+  o.camera = acvo::synth::scaledDefaultCamera(args.width, args.height);
+  const acvo::synth::SynthSequence sequence(o);
+  const int blackout_frames = static_cast<int>(std::lround(o.rate));  // 1 s
+
+  std::printf("acvo_soak: %d frames %dx%d at %g Hz, faults every %d frames\n", args.frames,
+              args.width, args.height, o.rate, args.fault_every);
+  acvo::Odometry odometry;
+  Tally tally;
+  tally.ms.reserve(std::size_t(args.frames));
+  const long rss_start = acvo::tools::residentKiB();
+  double previous_stamp = 0.0;
+  for (int i = 0; i < args.frames; ++i) {
+    const Fault fault = faultAt(i, args.fault_every, blackout_frames);
+    const acvo::Frame frame = inject(sequence.frame(i).toFrame(), fault, previous_stamp);
+    previous_stamp = frame.stamp;
+    const auto t0 = std::chrono::steady_clock::now();
+    const acvo::OdometryResult r = odometry.process(frame);
+    tally.add(
+        i, fault, r,
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+  }
+  tally.print(args.frames, rss_start, acvo::tools::residentKiB());
+  return tally.all_finite ? 0 : 1;
 }
 
 }  // namespace

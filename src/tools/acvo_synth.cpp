@@ -35,15 +35,8 @@ CLI::Option* addSwitch(CLI::App& app, const std::string& name, bool& value,
       ->default_str(value ? "on" : "off");
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  std::string output;
-  acvo::synth::SequenceOptions o;
-  int width = 640, height = 480;
-  CLI::App app{kDescription, "acvo_synth"};
-  acvo::tools::setUpCommandLine(app, kFooter);
-  app.add_option("OUTPUT_DIR", output, "the folder to write")->type_name("")->required();
+// The scene, the camera's path and the renderer's switches.
+void addSceneOptions(CLI::App& app, acvo::synth::SequenceOptions& o) {
   app.add_option("--frames", o.frames, "number of frames (at least 1)")
       ->type_name("N")
       ->capture_default_str()
@@ -73,6 +66,11 @@ int main(int argc, char** argv) {
   addSwitch(app, "--noise", o.noise,
             "Kinect-like depth noise, quantisation, dropouts; colour noise");
   addSwitch(app, "--blur", o.blur, "motion blur (mean of sub-frame renders over half a frame)");
+}
+
+// What a real camera does to the images: a second colour camera, unsynchronised streams, auto
+// exposure, a lens, a structured-light sensor's depth, a person in view.
+void addCameraFaults(CLI::App& app, acvo::synth::SequenceOptions& o) {
   app.add_option("--colour-focal-ratio", o.colour_focal_ratio,
                  "an unregistered colour camera: its focal length over the depth camera's "
                  "(7-Scenes: about 525/585)")
@@ -128,18 +126,10 @@ int main(int argc, char** argv) {
       ->type_name("M_PER_S")
       ->capture_default_str()
       ->transform(acvo::tools::numberIn(0.0, 5.0, "within [0, 5] m/s"));
-  const auto size = acvo::tools::numberIn(8, 8192, "within [8, 8192] pixels");
-  app.add_option("--width", width, "image width; the 640x480 intrinsics scale with the size")
-      ->type_name("W")
-      ->capture_default_str()
-      ->transform(size);
-  app.add_option("--height", height, "image height")
-      ->type_name("H")
-      ->capture_default_str()
-      ->transform(size);
-  if (const auto status = acvo::tools::parseCommandLine(app, argc, argv)) return *status;
-  o.camera = acvo::synth::scaledDefaultCamera(width, height);
+}
 
+// Renders and writes the sequence: 0, or the tool's exit status for a failure.
+int write(const CLI::App& app, const std::string& output, const acvo::synth::SequenceOptions& o) {
   const bool show_progress = isatty(fileno(stderr));
   const auto started = std::chrono::steady_clock::now();
   try {
@@ -161,4 +151,29 @@ int main(int argc, char** argv) {
   std::cout << "acvo_synth: wrote " << o.frames << " frames (" << o.camera.width << "x"
             << o.camera.height << ") to " << output << " in " << seconds << " s\n";
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string output;
+  acvo::synth::SequenceOptions o;
+  int width = 640, height = 480;
+  CLI::App app{kDescription, "acvo_synth"};
+  acvo::tools::setUpCommandLine(app, kFooter);
+  app.add_option("OUTPUT_DIR", output, "the folder to write")->type_name("")->required();
+  addSceneOptions(app, o);
+  addCameraFaults(app, o);
+  const auto size = acvo::tools::numberIn(8, 8192, "within [8, 8192] pixels");
+  app.add_option("--width", width, "image width; the 640x480 intrinsics scale with the size")
+      ->type_name("W")
+      ->capture_default_str()
+      ->transform(size);
+  app.add_option("--height", height, "image height")
+      ->type_name("H")
+      ->capture_default_str()
+      ->transform(size);
+  if (const auto status = acvo::tools::parseCommandLine(app, argc, argv)) return *status;
+  o.camera = acvo::synth::scaledDefaultCamera(width, height);
+  return write(app, output, o);
 }
