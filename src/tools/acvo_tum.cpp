@@ -175,6 +175,39 @@ std::optional<acvo::OdometryResult> processFrame(acvo::Odometry& odometry,
   return r;
 }
 
+// The frames first to last through the odometry: the trajectory, each frame's time (the first
+// frame's left out) and the frames lost or rejected.
+struct Run {
+  acvo::Trajectory trajectory;
+  std::vector<double> frame_ms;
+  long failures = 0;
+};
+
+Run runFrames(acvo::Odometry& odometry, const acvo::TumDataset& data, long first, long last,
+              StatsWriter& stats) {
+  const bool progress = isatty(STDERR_FILENO);
+  Run run;
+  for (long k = first; k < last; ++k) {
+    const auto& entry = data.frames()[std::size_t(k)];
+    const std::optional<acvo::OdometryResult> r = processFrame(odometry, data, k, progress);
+    run.failures += !r || r->tracking == acvo::Tracking::kLost ||
+                    r->tracking == acvo::Tracking::kBadFrame;
+    if (!r) continue;
+    if (r->tracking != acvo::Tracking::kBadFrame) {
+      run.trajectory.push_back({entry.rgb.stamp_text, entry.rgb.stamp, r->pose});
+    }
+    const double ms = r->ms_cloud + r->ms_registration + r->ms_window;
+    if (r->tracking != acvo::Tracking::kFirstFrame) run.frame_ms.push_back(ms);
+    stats.write(k, entry.rgb.stamp_text, *r);
+    if (progress) {
+      std::fprintf(stderr, "\racvo_tum: frame %ld/%ld  %3d it  %6.1f ms  %s    ", k - first + 1,
+                   last - first, r->solver.iterations, ms, acvo::toString(r->tracking).c_str());
+    }
+  }
+  if (progress) std::fprintf(stderr, "\n");
+  return run;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -208,33 +241,12 @@ int main(int argc, char** argv) {
         odometry.reset(p->pose);
       }
     }
-    const bool progress = isatty(STDERR_FILENO);
-    acvo::Trajectory trajectory;
-    std::vector<double> frame_ms;
-    long failures = 0;
-    for (long k = first; k < last; ++k) {
-      const auto& entry = data.frames()[std::size_t(k)];
-      const std::optional<acvo::OdometryResult> r = processFrame(odometry, data, k, progress);
-      failures += !r || r->tracking == acvo::Tracking::kLost ||
-                  r->tracking == acvo::Tracking::kBadFrame;
-      if (!r) continue;
-      if (r->tracking != acvo::Tracking::kBadFrame) {
-        trajectory.push_back({entry.rgb.stamp_text, entry.rgb.stamp, r->pose});
-      }
-      const double ms = r->ms_cloud + r->ms_registration;
-      if (r->tracking != acvo::Tracking::kFirstFrame) frame_ms.push_back(ms);
-      stats.write(k, entry.rgb.stamp_text, *r);
-      if (progress) {
-        std::fprintf(stderr, "\racvo_tum: frame %ld/%ld  %3d it  %6.1f ms  %s    ", k - first + 1,
-                     last - first, r->solver.iterations, ms, acvo::toString(r->tracking).c_str());
-      }
-    }
-    if (progress) std::fprintf(stderr, "\n");
-    acvo::writeTrajectory(output, trajectory, "acvo trajectory of " + opt.dataset);
-    std::printf("wrote %zu poses to %s\n", trajectory.size(), output.c_str());
-    std::printf("frames=%zu median_ms=%.3f p90_ms=%.3f failures=%ld\n", trajectory.size(),
-                acvo::tools::percentile(frame_ms, 0.5), acvo::tools::percentile(frame_ms, 0.9),
-                failures);
+    const Run run = runFrames(odometry, data, first, last, stats);
+    acvo::writeTrajectory(output, run.trajectory, "acvo trajectory of " + opt.dataset);
+    std::printf("wrote %zu poses to %s\n", run.trajectory.size(), output.c_str());
+    std::printf("frames=%zu median_ms=%.3f p90_ms=%.3f failures=%ld\n", run.trajectory.size(),
+                acvo::tools::percentile(run.frame_ms, 0.5),
+                acvo::tools::percentile(run.frame_ms, 0.9), run.failures);
     return 0;
   } catch (const std::exception& e) {
     std::cerr << "acvo_tum: " << e.what() << "\n";
