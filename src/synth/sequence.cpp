@@ -190,6 +190,37 @@ cv::Mat depthToPng16(const cv::Mat& depth_m, double depth_scale) {
   return out;
 }
 
+namespace {
+
+// The ground truth at the depth's stamps and, with the colour taken at other instants, at the
+// colour's too, in time order (as a motion-capture trajectory at a higher rate than the
+// camera's holds both).
+void writeSequenceTruth(const std::string& path, const std::string& about,
+                        const SynthSequence& sequence, const std::vector<std::string>& stamps,
+                        const std::vector<StampedFile>& rgb) {
+  std::vector<std::string> truth_stamps = stamps;
+  std::vector<Eigen::Isometry3d> truth_poses = sequence.poses();
+  const double delay = sequence.options().colour_delay;
+  if (delay != 0.0) {
+    truth_stamps.clear();
+    truth_poses.clear();
+    for (int i = 0; i < sequence.size(); ++i) {
+      for (int k = 0; k < 2; ++k) {
+        const bool colour = (k == 0) == (delay < 0.0);
+        truth_stamps.push_back(colour ? rgb[i].stamp : stamps[i]);
+        truth_poses.push_back(colour ? sequence.colourPose(i) : sequence.poses()[i]);
+      }
+    }
+  }
+  writeGroundtruth(path,
+                   "ground truth trajectory: camera-to-world, optical frame (x right, y down, "
+                   "z forward)\n" +
+                       about,
+                   truth_stamps, truth_poses);
+}
+
+}  // namespace
+
 void writeSequence(const std::string& folder, const SequenceOptions& options,
                    const std::function<void(int done, int total)>& progress) {
   const SynthSequence sequence(options);
@@ -231,27 +262,7 @@ void writeSequence(const std::string& folder, const SequenceOptions& options,
   writeFileList((root / "rgb.txt").string(), "color images\n" + about, rgb);
   writeFileList((root / "depth.txt").string(), "depth maps\n" + about, depth);
   writeAssociations((root / "associations.txt").string(), about, rgb, depth);
-  // With the colour taken later, the poses of both stamps, in time order (as a motion-capture
-  // trajectory at a higher rate than the camera's holds both).
-  std::vector<std::string> truth_stamps = stamps;
-  std::vector<Eigen::Isometry3d> truth_poses = sequence.poses();
-  if (options.colour_delay != 0.0) {
-    truth_stamps.clear();
-    truth_poses.clear();
-    for (int i = 0; i < n; ++i) {
-      const bool colour_first = options.colour_delay < 0.0;
-      for (int k = 0; k < 2; ++k) {
-        const bool colour = (k == 0) == colour_first;
-        truth_stamps.push_back(colour ? rgb[i].stamp : stamps[i]);
-        truth_poses.push_back(colour ? sequence.colourPose(i) : sequence.poses()[i]);
-      }
-    }
-  }
-  writeGroundtruth((root / "groundtruth.txt").string(),
-                   "ground truth trajectory: camera-to-world, optical frame (x right, y down, "
-                   "z forward)\n" +
-                       about,
-                   truth_stamps, truth_poses);
+  writeSequenceTruth((root / "groundtruth.txt").string(), about, sequence, stamps, rgb);
   saveCameraYaml((root / "camera.yaml").string(), options.camera);
 }
 

@@ -104,6 +104,10 @@ Motion::Motion(const MotionOptions& options) : options_(options) {
     translation_gain_ = rotation_gain_ = 0.0;
     return;
   }
+  fitGains(options);
+}
+
+void Motion::fitGains(const MotionOptions& options) {
   // Gains that give the requested mean speeds over the sequence (at least one frame
   // interval), measured on a fine grid.
   const int intervals = std::max(options.frames - 1, 1);

@@ -66,6 +66,8 @@ class Motion {
     double amplitude, frequency, phase;
   };
   static Eigen::Vector3d sumWaves(const std::vector<Wave> (&waves)[3], double t);
+  // The random motion's gains: the mean speeds asked for, within the room.
+  void fitGains(const MotionOptions& options);
   Eigen::Isometry3d randomPose(double t) const;
   Eigen::Isometry3d xyzPose(double t) const;
   Eigen::Isometry3d rpyPose(double t) const;
