@@ -145,68 +145,79 @@ std::string IntrinsicsOverride::problem() const {
   return {};
 }
 
+namespace {
+
+// Named intrinsics are for 640x480; a driver streaming another resolution of the same sensor
+// scales them (the principal point about the image corner, pixel centres being at integer
+// coordinates).
+acvo::Camera namedCameraFor(const std::string& name, int width, int height) {
+  acvo::Camera cam = acvo::cameraByName(name);
+  const double sx = static_cast<double>(width) / cam.width;
+  const double sy = static_cast<double>(height) / cam.height;
+  cam.fx *= sx;
+  cam.fy *= sy;
+  cam.cx = (cam.cx + 0.5) * sx - 0.5;
+  cam.cy = (cam.cy + 0.5) * sy - 0.5;
+  return cam;
+}
+
+// The intrinsics camera_info gives for images of width x height into `cam`: empty, or why not.
+std::string intrinsicsFromInfo(const sensor_msgs::CameraInfo& info, int width, int height,
+                               acvo::Camera& cam) {
+  // image_geometry reads camera_info as the ROS drivers mean it: the projection matrix P (the
+  // rectified image's intrinsics, which K is not for a distorted camera), scaled for binning and
+  // shifted for a region of interest.
+  image_geometry::PinholeCameraModel model;
+  try {
+    model.fromCameraInfo(info);
+  } catch (const std::exception& e) {
+    return std::string("camera_info cannot be read: ") + e.what();
+  }
+  const cv::Size reduced = model.reducedResolution();
+  if (reduced.width != width || reduced.height != height) {
+    const bool scaled = info.binning_x > 1 || info.binning_y > 1 || info.roi.width > 0;
+    return "camera_info size " + std::to_string(info.width) + "x" + std::to_string(info.height) +
+           (scaled ? " (" + std::to_string(reduced.width) + "x" +
+                         std::to_string(reduced.height) + " after binning and ROI)"
+                   : std::string()) +
+           " differs from the image's " + std::to_string(width) + "x" + std::to_string(height);
+  }
+  // A driver that fills K alone (P all zero): K, adjusted alike.
+  const bool has_p = hasProjection(info);
+  const cv::Matx33d k =
+      has_p ? model.projectionMatrix().get_minor<3, 3>(0, 0) : model.intrinsicMatrix();
+  cam.fx = k(0, 0);
+  cam.fy = k(1, 1);
+  cam.cx = k(0, 2);
+  cam.cy = k(1, 2);
+  // (A negative focal length is a mirrored image axis, as acvo::Camera takes it.)
+  if (!(cam.fx != 0.0 && cam.fy != 0.0 && std::isfinite(cam.fx) && std::isfinite(cam.fy) &&
+        std::isfinite(cam.cx) && std::isfinite(cam.cy))) {
+    return std::string("camera_info ") + (has_p ? "P" : "K") +
+           " has a zero or non-finite focal length or centre (fx " + std::to_string(cam.fx) +
+           ", fy " + std::to_string(cam.fy) + ")";
+  }
+  return {};
+}
+
+}  // namespace
+
 CameraResult cameraFor(const sensor_msgs::CameraInfo& info, int width, int height,
                        const IntrinsicsOverride& override_intrinsics) {
   CameraResult out;
   out.problem = override_intrinsics.problem();
   if (!out.problem.empty()) return out;
   acvo::Camera& cam = out.camera;
-
   if (override_intrinsics.explicitValues()) {
     cam.fx = override_intrinsics.fx;
     cam.fy = override_intrinsics.fy;
     cam.cx = override_intrinsics.cx;
     cam.cy = override_intrinsics.cy;
   } else if (override_intrinsics.named()) {
-    cam = acvo::cameraByName(override_intrinsics.camera);
-    // Named intrinsics are for 640x480; a driver streaming another resolution of the same
-    // sensor scales them (the principal point about the image corner, pixel centres being
-    // at integer coordinates).
-    const double sx = static_cast<double>(width) / cam.width;
-    const double sy = static_cast<double>(height) / cam.height;
-    cam.fx *= sx;
-    cam.fy *= sy;
-    cam.cx = (cam.cx + 0.5) * sx - 0.5;
-    cam.cy = (cam.cy + 0.5) * sy - 0.5;
+    cam = namedCameraFor(override_intrinsics.camera, width, height);
   } else {
-    // image_geometry reads camera_info as the ROS drivers mean it: the projection matrix P
-    // (the rectified image's intrinsics, which K is not for a distorted camera), scaled for
-    // binning and shifted for a region of interest.
-    image_geometry::PinholeCameraModel model;
-    try {
-      model.fromCameraInfo(info);
-    } catch (const std::exception& e) {
-      out.problem = std::string("camera_info cannot be read: ") + e.what();
-      return out;
-    }
-    const cv::Size reduced = model.reducedResolution();
-    if (reduced.width != width || reduced.height != height) {
-      const bool scaled = info.binning_x > 1 || info.binning_y > 1 || info.roi.width > 0;
-      out.problem = "camera_info size " + std::to_string(info.width) + "x" +
-                    std::to_string(info.height) +
-                    (scaled ? " (" + std::to_string(reduced.width) + "x" +
-                                  std::to_string(reduced.height) + " after binning and ROI)"
-                            : std::string()) +
-                    " differs from the image's " + std::to_string(width) + "x" +
-                    std::to_string(height);
-      return out;
-    }
-    // A driver that fills K alone (P all zero): K, adjusted alike.
-    const bool has_p = hasProjection(info);
-    const cv::Matx33d k = has_p ? model.projectionMatrix().get_minor<3, 3>(0, 0)
-                                : model.intrinsicMatrix();
-    cam.fx = k(0, 0);
-    cam.fy = k(1, 1);
-    cam.cx = k(0, 2);
-    cam.cy = k(1, 2);
-    // (A negative focal length is a mirrored image axis, as acvo::Camera takes it.)
-    if (!(cam.fx != 0.0 && cam.fy != 0.0 && std::isfinite(cam.fx) && std::isfinite(cam.fy) &&
-          std::isfinite(cam.cx) && std::isfinite(cam.cy))) {
-      out.problem = std::string("camera_info ") + (has_p ? "P" : "K") +
-                    " has a zero or non-finite focal length or centre (fx " +
-                    std::to_string(cam.fx) + ", fy " + std::to_string(cam.fy) + ")";
-      return out;
-    }
+    out.problem = intrinsicsFromInfo(info, width, height, cam);
+    if (!out.problem.empty()) return out;
   }
   cam.width = width;
   cam.height = height;

@@ -16,39 +16,34 @@ std::string wrongType(const std::string& key, const char* expected) {
 }
 
 // Each reader leaves `field` alone when the key is absent, and reports a wrong type.
-void read(const XmlRpcValue& ns, const std::string& key, std::string& field,
-          std::vector<std::string>& problems) {
+template <typename T>
+void readAs(const XmlRpcValue& ns, const std::string& key, T& field, XmlRpcValue::Type type,
+            const char* type_name, std::vector<std::string>& problems) {
   if (!ns.hasMember(key)) return;
   const XmlRpcValue& v = ns[key];
-  if (v.getType() != XmlRpcValue::TypeString) {
-    problems.push_back(wrongType(key, "a string"));
+  if (v.getType() != type) {
+    problems.push_back(wrongType(key, type_name));
     return;
   }
-  field = static_cast<const std::string&>(v);
+  field = static_cast<const T&>(v);
+}
+
+void read(const XmlRpcValue& ns, const std::string& key, std::string& field,
+          std::vector<std::string>& problems) {
+  readAs(ns, key, field, XmlRpcValue::TypeString, "a string", problems);
 }
 
 void read(const XmlRpcValue& ns, const std::string& key, bool& field,
           std::vector<std::string>& problems) {
-  if (!ns.hasMember(key)) return;
-  const XmlRpcValue& v = ns[key];
-  if (v.getType() != XmlRpcValue::TypeBoolean) {
-    problems.push_back(wrongType(key, "true or false"));
-    return;
-  }
-  field = static_cast<const bool&>(v);
+  readAs(ns, key, field, XmlRpcValue::TypeBoolean, "true or false", problems);
 }
 
 void read(const XmlRpcValue& ns, const std::string& key, int& field,
           std::vector<std::string>& problems) {
-  if (!ns.hasMember(key)) return;
-  const XmlRpcValue& v = ns[key];
-  if (v.getType() != XmlRpcValue::TypeInt) {
-    problems.push_back(wrongType(key, "an integer"));
-    return;
-  }
-  field = static_cast<const int&>(v);
+  readAs(ns, key, field, XmlRpcValue::TypeInt, "an integer", problems);
 }
 
+// A number may be written as an integer.
 void read(const XmlRpcValue& ns, const std::string& key, double& field,
           std::vector<std::string>& problems) {
   if (!ns.hasMember(key)) return;
