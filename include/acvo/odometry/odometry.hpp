@@ -24,6 +24,7 @@
 #include "acvo/odometry/second_start.hpp"
 #include "acvo/odometry/tracking.hpp"
 #include "acvo/odometry/velocity_changes.hpp"
+#include "acvo/odometry/window.hpp"
 #include "acvo/params.hpp"
 #include "acvo/registration/engine.hpp"
 
@@ -221,12 +222,7 @@ class Odometry {
   std::optional<Tracked> last_;  // the last tracked frame (the keyframe itself, or after it)
   // The local window: its keyframes, oldest first, the current keyframe last (empty without a
   // window), and the registrations that link them, by frame index.
-  struct Link {
-    std::uint64_t fixed = 0;
-    std::uint64_t moving = 0;
-    Eigen::Isometry3d measured = Eigen::Isometry3d::Identity();
-    Matrix6d information = Matrix6d::Zero();
-  };
+  using Link = LinkBetween<std::uint64_t>;
   std::deque<Tracked> window_;
   std::vector<Link> links_;
   // Keyframes that left the window, with their last poses, held fixed while a keyframe in the

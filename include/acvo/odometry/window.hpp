@@ -17,15 +17,18 @@
 
 namespace acvo {
 
-struct WindowLink {
-  // Positions of the link's two keyframes among the window's poses.
-  int fixed = 0;
-  int moving = 0;
+// One link between two keyframes, named by Key: the odometry keeps them by frame index, the
+// window's math by position among its poses.
+template <typename Key>
+struct LinkBetween {
+  Key fixed{};
+  Key moving{};
   // The registration's transform (T: moving -> fixed) and its information (-H, the inverse of
   // the registration's covariance).
   Eigen::Isometry3d measured = Eigen::Isometry3d::Identity();
   Matrix6d information = Matrix6d::Zero();
 };
+using WindowLink = LinkBetween<int>;
 
 // r of one link at the given poses (camera -> odometry frame).
 Vector6d linkResidual(const std::vector<Eigen::Isometry3d>& poses, const WindowLink& link);
