@@ -83,6 +83,7 @@ class ColourDepthCheck {
 
   enum class State { kUndecided, kRegistered, kUnregistered };
 
+  // Undecided from early_frames on, the figures say what the evidence so far gives.
   struct Verdict {
     State state = State::kUndecided;
     // The colour focal length over the depth's that fits best alone (no baseline, every edge
