@@ -129,12 +129,11 @@ TEST(Sequences, DepthNoiseInBlobsAsARealKinectsCostsLittle) {
 
 // Colour from a second camera, as 7-Scenes' (a Kinect's raw depth paired with its colour): 0.897
 // times the depth camera's focal length, 2.5 cm beside it, the depth's noise in blobs. Once the
-// colour check judges it unregistered (the tenth frame: 1.4x, short of the early verdict's
-// 1.5x), each frame's colour is resampled to
-// the depth camera by the focal ratio it found, the photometric term is left out (the
-// baseline's offset remains) and the last level is led by the depth; as it came, the points
-// chosen at the colour's edges sit where the texture appears, which slides along the surfaces
-// with the motion.
+// colour check judges it unregistered (at the tenth frame, 1.4x: too little for the early
+// verdict's 1.5x), each frame's colour is resampled to the depth camera by the focal ratio it
+// found, the photometric term is left out (the baseline's offset remains) and the last level
+// is led by the depth; as it came, the points chosen at the colour's edges sit where the
+// texture appears, which slides along the surfaces with the motion.
 TEST(Sequences, ColourFromASecondCameraIsResampledToTheDepthCamera) {
   synth::SequenceOptions o;
   o.frames = 120;

@@ -59,9 +59,9 @@ class ColourDepthCheck {
   // Odometry gives it every kFrameStep-th frame until it decides. Every frame: the verdict
   // comes at the tenth frame with enough depth edges, or at the third where the evidence is
   // clear (early_frames: 7-Scenes' kitchen, 2.1x), so that colour from a second camera is
-  // resampled (withColourResampled) from the first tenth or third of a second on. A frame looked at
-  // costs about as much as registering one (the grid of 41 x 13 cameras on its thinned edge
-  // pixels, up to 2000 of them), on those first frames only.
+  // resampled (withColourResampled) after a third of a second at 30 Hz, or a tenth where clear.
+  // A frame looked at costs about as much as registering one (the grid of 41 x 13 cameras on
+  // its thinned edge pixels, up to 2000 of them), on those first frames only.
   static constexpr int kFrameStep = 1;
 
   struct Options {
