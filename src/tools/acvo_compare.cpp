@@ -49,6 +49,9 @@ turn; times cover the odometry call only (acvo: cloud building and registration;
 conversion, hole marking, pyramids and registration).
 --stride K keeps every K-th frame: the same camera moving K times faster between frames, the
 way to see how wide each method's basin is (the dataset is then named <folder>_everyK).
+--starts runs each folder from several first frames and gives each row the mean of their
+errors: a short folder from one first frame is one draw of its errors, and a change is better
+judged over several.
 --camera gives every method other intrinsics than the folder's camera.yaml: a calibration of
 one's own, or a focal length a few percent off to see how much each method depends on it.
 --offset auto evaluates each dataset at the offset between the reference's clock and the
@@ -66,6 +69,7 @@ struct Options {
   std::vector<int> threads{1};
   std::string config, label = "acvo", json, trajectories, camera;
   long frames = -1, stride = 1;
+  std::vector<long> starts{0};
   int repeat = 1;
   std::vector<std::string> peer_guess{"none", "last"};
   std::optional<double> offset = 0.0;  // empty: estimated per dataset (--offset auto)
@@ -127,6 +131,16 @@ void addInputOptions(CLI::App& app, Options& o) {
       ->type_name("N")
       ->check(
           acvo::tools::numberIn(0L, std::numeric_limits<long>::max(), "a non-negative integer"));
+  app.add_option("--starts", o.starts,
+                 "first frames (0-based, before --stride), one run of every row from each; with "
+                 "more than one, the errors are the means over them (where evaluated), the lost "
+                 "frames their sum")
+      ->type_name("LIST")
+      ->delimiter(',')
+      ->allow_extra_args(false)
+      ->default_str("0")
+      ->check(
+          acvo::tools::numberIn(0L, std::numeric_limits<long>::max(), "a non-negative integer"));
   app.add_option("--stride", o.stride,
                  "use every K-th frame (a camera K times faster); --frames counts the frames used")
       ->type_name("K")
@@ -153,6 +167,7 @@ std::optional<int> parseOptions(CLI::App& app, Options& o, int argc, char** argv
   if (o.peer_max_depth.empty()) return acvo::tools::usageError(app, "--peer-max-depth is empty");
   if (o.peer_guess.empty()) return acvo::tools::usageError(app, "--peer-guess is empty");
   if (o.threads.empty()) return acvo::tools::usageError(app, "--threads is empty");
+  if (o.starts.empty()) return acvo::tools::usageError(app, "--starts is empty");
   return std::nullopt;
 }
 
@@ -269,89 +284,67 @@ void runOnce(std::vector<Entry>& entries, const std::vector<acvo::Frame>& frames
   }
 }
 
-void evaluate(Row& row, const acvo::TumDataset& data, double offset) {
-  row.offset = offset;
-  if (!data.groundtruth()) return;
-  try {
-    const acvo::Trajectory& gt = *data.groundtruth();
-    const acvo::RpeResult rpe =
-        acvo::computeRpe(gt, row.trajectory, 1.0, acvo::DeltaUnit::kSeconds, offset);
-    row.rpe_trans = rpe.trans.rmse;
-    row.rpe_rot = rpe.rot_deg.rmse;
-    row.ate = acvo::computeAte(gt, row.trajectory, 0.02, offset).trans.rmse;
-  } catch (const std::exception& e) {
-    std::cerr << "acvo_compare: " << row.dataset << " " << row.method << " " << row.setting
-              << ": no evaluation: " << e.what() << "\n";
-  }
-}
-
-// Every row evaluated at --offset, or at the offset found from all of them (--offset auto).
-void evaluateAll(const Options& opt, const acvo::TumDataset& data, const std::string& dataset,
-                 std::vector<Row>& rows, std::vector<std::string>& notes) {
-  double offset = opt.offset.value_or(0.0);
-  std::string refused;
-  if (!opt.offset && data.groundtruth()) {
-    std::vector<acvo::Trajectory> trajectories;
-    for (const auto& row : rows) trajectories.push_back(row.trajectory);
-    try {
-      offset = acvo::estimateClockOffset(*data.groundtruth(), trajectories).offset;
-      notes.push_back("# " + dataset + ": the frames' stamps " + acvo::tools::milliseconds(offset) +
-                      " against the reference's (--offset auto)");
-    } catch (const std::exception& e) {
-      refused = e.what();
-      notes.push_back("# " + dataset + ": evaluated at offset 0: " + refused);
-    }
-  }
-  for (auto& row : rows) {
-    evaluate(row, data, offset);
-    row.offset_found = !opt.offset && refused.empty() && data.groundtruth();
-    row.offset_refused = refused;
-  }
-}
-
-// The rows of one folder, each peer's best setting after its last (where it has several), and
-// the notes to print below the table.
-void compareFolder(const Options& opt, const acvo::Params& params, const std::string& folder,
-                   std::vector<Row>& rows, std::vector<std::string>& notes) {
-  const acvo::TumDataset data(folder, opt.camera);
-  // The dataset's frames used: every stride-th, at most --frames of them.
+// The rows of one folder run from frame `first`, evaluated, their trajectories written.
+std::vector<Row> runFrom(const Options& opt, const acvo::Params& params,
+                         const acvo::TumDataset& data, const std::string& dataset, long first,
+                         std::vector<std::string>& notes) {
+  // The dataset's frames used: every stride-th from `first`, at most --frames of them.
   std::vector<std::size_t> index;
-  for (std::size_t i = 0; i < data.size(); i += std::size_t(opt.stride)) {
+  for (auto i = std::size_t(first); i < data.size(); i += std::size_t(opt.stride)) {
     if (opt.frames >= 0 && index.size() >= std::size_t(opt.frames)) break;
     index.push_back(i);
   }
   std::vector<acvo::Frame> frames;
   frames.reserve(index.size());
   for (const std::size_t i : index) frames.push_back(data.loadFrame(i));
-  if (frames.empty()) throw std::runtime_error(folder + ": no frames");
-  const std::string dataset =
-      baseName(folder) + (opt.stride > 1 ? "_every" + std::to_string(opt.stride) : "");
+  if (frames.empty()) {
+    throw std::runtime_error(dataset + ": no frames from frame " + std::to_string(first));
+  }
   std::vector<Entry> entries =
       entriesFor(opt, params, data, dataset, startPose(data, frames.front().stamp));
   for (int run = 0; run < opt.repeat; ++run) runOnce(entries, frames, index, data, run == 0);
+  std::vector<Row> rows;
+  for (auto& e : entries) rows.push_back(std::move(e.row));
+  const bool several = opt.starts.size() > 1;
+  const std::string from = several ? "-from" + std::to_string(first) : "";
+  acvo::tools::evaluateRows(rows, data.groundtruth(), opt.offset,
+                            several ? dataset + " from frame " + std::to_string(first) : dataset,
+                            notes);
+  for (auto& row : rows) {
+    row.starts = {first};
+    row.frames = row.trajectory.size();
+    if (opt.trajectories.empty()) continue;
+    const bool plain = row.method == opt.label && opt.threads.size() == 1;
+    acvo::writeTrajectory(opt.trajectories + "/" + dataset + "-" + row.method +
+                              (plain ? "" : "-" + row.setting) + from + ".txt",
+                          row.trajectory, row.method + " " + row.setting + " on " + data.folder());
+  }
+  return rows;
+}
+
+// The rows of one folder over every start, each peer's best setting after its last (where it
+// has several), and the notes to print below the table.
+void compareFolder(const Options& opt, const acvo::Params& params, const std::string& folder,
+                   std::vector<Row>& rows, std::vector<std::string>& notes) {
+  const acvo::TumDataset data(folder, opt.camera);
+  const std::string dataset =
+      baseName(folder) + (opt.stride > 1 ? "_every" + std::to_string(opt.stride) : "");
   std::vector<Row> folder_rows;
-  for (auto& e : entries) folder_rows.push_back(std::move(e.row));
-  evaluateAll(opt, data, dataset, folder_rows, notes);
+  for (const long first : opt.starts) {
+    acvo::tools::poolStarts(folder_rows, runFrom(opt, params, data, dataset, first, notes));
+  }
 
   // The best setting of each peer, and the speed ratio to the best RgbdOdometry, per run.
   const auto best = acvo::tools::bestRows(folder_rows, opt.label);
   const auto rgbd = best.find("rgbd");
   for (auto& row : folder_rows) {
-    for (int run = 0; run < opt.repeat; ++run) {
-      row.ratio.push_back(rgbd == best.end()
-                              ? NAN
-                              : row.median_ms[std::size_t(run)] /
-                                    folder_rows[rgbd->second].median_ms[std::size_t(run)]);
+    for (std::size_t run = 0; run < row.median_ms.size(); ++run) {
+      row.ratio.push_back(
+          rgbd == best.end() ? NAN : row.median_ms[run] / folder_rows[rgbd->second].median_ms[run]);
     }
   }
   for (std::size_t k = 0; k < folder_rows.size(); ++k) {
     const Row& row = folder_rows[k];
-    if (!opt.trajectories.empty()) {
-      const bool plain = row.method == opt.label && opt.threads.size() == 1;
-      acvo::writeTrajectory(opt.trajectories + "/" + dataset + "-" + row.method +
-                                (plain ? "" : "-" + row.setting) + ".txt",
-                            row.trajectory, row.method + " " + row.setting + " on " + folder);
-    }
     rows.push_back(row);
     // After a peer's last setting, its best one again, named as such.
     const bool last_of_method =
@@ -383,7 +376,7 @@ int main(int argc, char** argv) {
     std::vector<Row> rows;
     std::vector<std::string> notes;  // printed below the table
     for (const auto& folder : opt.datasets) compareFolder(opt, params, folder, rows, notes);
-    const acvo::tools::CompareRun run{opt.threads, opt.repeat, opt.camera, opt.offset};
+    const acvo::tools::CompareRun run{opt.threads, opt.repeat, opt.camera, opt.offset, opt.starts};
     acvo::tools::printCompareTable(rows, run);
     for (const std::string& note : notes) std::printf("%s\n", note.c_str());
     if (!opt.json.empty()) acvo::tools::writeCompareJson(rows, run, opt.json);

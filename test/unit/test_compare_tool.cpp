@@ -1,6 +1,6 @@
 // acvo_compare end to end on a small synthetic sequence: the table's columns and rows (a row
 // per method and setting, the best peer setting named), the speed ratio's reference row, the
-// JSON beside it, threads and repeats, and the errors for bad arguments. Whether the peers are
+// JSON beside it, threads, repeats and starts, and the errors for bad arguments. Whether the peers are
 // set up right is test_peers' question.
 #include <gtest/gtest.h>
 
@@ -294,6 +294,68 @@ TEST_F(CompareTool, APoseOfDepthAloneCarriesTheDepthsStamp) {
   }
 }
 
+// The first number after `"key": ` (or after its list's "[") in the JSON, from `from` on.
+double jsonNumberAfter(const std::string& json, const std::string& key, std::size_t from = 0) {
+  auto at = json.find("\"" + key + "\": ", from);
+  if (at == std::string::npos) return NAN;
+  at += key.size() + 4;
+  if (json[at] == '[') ++at;
+  return std::stod(json.substr(at));
+}
+
+// --starts 0,6 runs every row from frame 0 and again from frame 6 (34 frames each: RPE over 1 s
+// needs 31): each error is the mean of the two runs' (each as a run from that start alone gives
+// it), the JSON keeps both, the trajectories are written per start, and the times of both runs
+// are pooled.
+TEST_F(CompareTool, SeveralStartsGiveTheMeanOfTheirRuns) {
+  const std::string room = "'" + (dir_ / "room").string() +
+                           "' --methods acvo,rgbd --peer-max-depth 4 --peer-guess none --frames 34";
+  const fs::path both = dir_ / "starts.txt", json = dir_ / "starts.json";
+  const fs::path traj = dir_ / "traj_starts";
+  fs::create_directories(traj);
+  std::vector<std::string> single(2);
+  for (std::size_t k = 0; k < 2; ++k) {
+    const fs::path j = dir_ / ("start" + std::to_string(k) + ".json");
+    ASSERT_EQ(runTool("acvo_compare",
+                      room + " --starts " + (k ? "6" : "0") + " --json '" + j.string() + "'",
+                      dir_ / ("start" + std::to_string(k) + ".txt")),
+              0);
+    single[k] = readText(j);
+  }
+  const std::string header = readText(dir_ / "start1.txt");
+  EXPECT_NE(header.substr(0, header.find('\n')).find("; from frame 6"), std::string::npos)
+      << header;
+  ASSERT_EQ(runTool("acvo_compare",
+                    room + " --starts 0,6 --json '" + json.string() + "' --trajectories '" +
+                        traj.string() + "'",
+                    both),
+            0);
+  const std::string text = readText(both), j = readText(json);
+  EXPECT_NE(text.find("errors: the mean over the runs from frames 0,6, lost: their sum"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("median of 2 runs"), std::string::npos) << text;
+  const auto rows = words(both);
+  ASSERT_EQ(rows.size(), 3u) << text;
+  EXPECT_EQ(rows[1][0], "room");
+  EXPECT_EQ(j.find("\"starts\": [0, 6]"), j.find("\"starts\":")) << j;
+  for (const std::string key : {"rpe_trans", "rpe_rot_deg", "ate"}) {
+    const double a = jsonNumberAfter(single[0], key), b = jsonNumberAfter(single[1], key);
+    ASSERT_TRUE(std::isfinite(a) && std::isfinite(b)) << key;
+    EXPECT_NE(a, b) << key << ": the two starts are different runs";
+    EXPECT_NEAR(jsonNumberAfter(j, key), 0.5 * (a + b), 1e-5 * (a + b)) << key;
+    EXPECT_NEAR(jsonNumberAfter(j, key + "_starts"), a, 1e-6 * a) << key;
+  }
+  EXPECT_EQ(jsonNumberAfter(j, "frames"), 68.0);
+  EXPECT_EQ(count(j, "\"vs_rgbd_runs\": [1, 1]"), 1) << "the yardstick, once per start";
+  const auto from0 = words(traj / "room-acvo-from0.txt");
+  const auto from6 = words(traj / "room-acvo-from6.txt");
+  ASSERT_EQ(from0.size(), 34u);
+  ASSERT_EQ(from6.size(), 34u);
+  EXPECT_EQ(from6[0][0], from0[6][0]) << "the run from frame 6 begins at its stamp";
+  EXPECT_EQ(runTool("acvo_compare", room + " --starts 0,1000", both), 2) << "no frames there";
+}
+
 TEST_F(CompareTool, BadArgumentsExitWithStatusTwo) {
   const fs::path out = dir_ / "bad.txt";
   const std::string room = "'" + (dir_ / "room").string() + "'";
@@ -305,6 +367,8 @@ TEST_F(CompareTool, BadArgumentsExitWithStatusTwo) {
   EXPECT_EQ(runTool("acvo_compare", room + " --peer-max-depth 0", out), 2);
   EXPECT_EQ(runTool("acvo_compare", room + " --peer-guess previous", out), 2);
   EXPECT_EQ(runTool("acvo_compare", room + " --offset soon", out), 2);
+  EXPECT_EQ(runTool("acvo_compare", room + " --starts -1", out), 2);
+  EXPECT_EQ(runTool("acvo_compare", room + " --starts ,", out), 2);
   EXPECT_EQ(runTool("acvo_compare", "'" + (dir_ / "missing").string() + "'", out), 2);
 }
 
