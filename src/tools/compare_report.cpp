@@ -204,9 +204,7 @@ void writeCompareJson(const std::vector<CompareRow>& rows, const CompareRun& run
   out << "{\"rpe_delta_s\": 1, \"repeat\": " << run.repeat
       << ", \"starts\": " << jsonList(run.starts);
   if (!run.camera.empty()) out << ", \"camera\": " << jsonString(run.camera);
-  out << ", \"acvo_threads\": [";
-  for (std::size_t k = 0; k < run.threads.size(); ++k) out << (k ? ", " : "") << run.threads[k];
-  out << "], \"runs\": [";
+  out << ", \"acvo_threads\": " << jsonList(run.threads) << ", \"runs\": [";
   for (std::size_t k = 0; k < rows.size(); ++k) {
     const CompareRow& r = rows[k];
     out << (k ? ",\n  " : "\n  ") << "{\"dataset\": " << jsonString(r.dataset)

@@ -1,7 +1,7 @@
 // acvo_compare end to end on a small synthetic sequence: the table's columns and rows (a row
 // per method and setting, the best peer setting named), the speed ratio's reference row, the
-// JSON beside it, threads, repeats and starts, and the errors for bad arguments. Whether the peers are
-// set up right is test_peers' question.
+// JSON beside it, threads, repeats and starts, and the errors for bad arguments. Whether the
+// peers are set up right is test_peers' question.
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -384,10 +384,11 @@ TEST(Odometry, ResetStartsAgainFromTheGivenPose) {
 // Colour from a second camera (0.897 times the depth's focal length, exact depth): the colour
 // check decides at the third frame (the evidence is clear: the early verdict); that frame
 // becomes the keyframe, its cloud built again from the resampled colour (a grey value at a
-// selected pixel tells which), and every frame after it is resampled by the ratio found. The frames given are not changed. reset() keeps the
-// verdict, which concerns the camera; newCamera() drops it, takeColourCheck() carries it to
-// another Odometry (a parameter change). With unregistered_colour as_given, the verdict
-// alone. A registered camera: the verdict, nothing resampled.
+// selected pixel tells which), and every frame after it is resampled by the ratio found. The
+// frames given are not changed. reset() keeps the verdict, which concerns the camera;
+// newCamera() drops it, takeColourCheck() carries it to another Odometry (a parameter change).
+// With unregistered_colour as_given, the verdict alone. A registered camera: the verdict,
+// nothing resampled.
 TEST(Odometry, ColourFromASecondCameraIsResampledFromTheVerdictOn) {
   synth::SequenceOptions o;
   o.frames = 16;
