@@ -1,4 +1,5 @@
 // The local window's cost, gradient and refinement (odometry/window.hpp, docs/method.md §7.7).
+#include <optional>
 #include <random>
 #include <vector>
 
@@ -140,6 +141,61 @@ TEST(Window, HeldPosesStayAndAnUnlinkedPoseKeepsItsValue) {
   EXPECT_TRUE(w.poses[2].isApprox(before[2], 1e-12));
   EXPECT_FALSE(w.poses[3].isApprox(before[3], 1e-6));
   EXPECT_LT(windowGradient(w.poses, links).tail<6>().norm(), 1e-8);
+}
+
+TEST(Window, ACentreLinkIsAFullLinkWhoseRotationIsUnknown) {
+  // centreInformation is the limit of the full information as the rotation's variance about the
+  // moving keyframe's centre grows without bound: the rotation is left free, not held known.
+  std::mt19937 rng(13);
+  for (int trial = 0; trial < 5; ++trial) {
+    const Matrix6d covariance = randomInformation(rng).inverse();
+    const Eigen::Isometry3d measured = expSE3(randomTwist(rng, 0.3, 0.5));
+    const std::optional<Matrix6d> centre = centreInformation(covariance, measured);
+    ASSERT_TRUE(centre.has_value());
+    // A rotation variance k (1e7) about the centre is Ad(T_hat) diag(k, 0) Ad(T_hat)^T in
+    // the left perturbation's coordinates.
+    const Matrix6d to_left = adjointSE3(measured);
+    Matrix6d free_rotation = Matrix6d::Zero();
+    free_rotation.topLeftCorner<3, 3>() = 1e7 * Eigen::Matrix3d::Identity();
+    const Matrix6d limit = (covariance + to_left * free_rotation * to_left.transpose()).inverse();
+    EXPECT_LT((limit - *centre).norm(), 1e-5 * centre->norm()) << "trial " << trial;
+    // Not the translation block of the full information (that would hold the rotation known).
+    Matrix6d held = Matrix6d::Zero();
+    held.bottomRightCorner<3, 3>() =
+        (to_left.inverse().transpose() * covariance.inverse() * to_left.inverse())
+            .bottomRightCorner<3, 3>();
+    EXPECT_GT((to_left.transpose() * held * to_left - *centre).norm(), 0.1 * centre->norm());
+  }
+  EXPECT_FALSE(centreInformation(Matrix6d::Zero(), Eigen::Isometry3d::Identity()).has_value());
+}
+
+TEST(Window, ALinkThatDisagreesOnlyInRotationMovesNoPose) {
+  // Three keyframes along a path, chained by exact links. A link from the first to the third
+  // whose transform is turned about the third's centre moves nothing as a centre link, and pulls
+  // the third's rotation as a full one.
+  std::mt19937 rng(17);
+  std::vector<Eigen::Isometry3d> truth{expSE3(randomTwist(rng, 0.5, 1.0))};
+  for (int k = 0; k < 2; ++k) truth.push_back(truth.back() * expSE3(randomTwist(rng, 0.1, 0.2)));
+  const Matrix6d info = randomInformation(rng);
+  const Eigen::Isometry3d turned = truth[0].inverse() * truth[2] *
+                                   expSE3((Vector6d() << 0.02, -0.01, 0.015, 0, 0, 0).finished());
+  const Matrix6d covariance = randomInformation(rng).inverse();
+  for (const bool centre_only : {true, false}) {
+    std::vector<Eigen::Isometry3d> poses = truth;
+    const Matrix6d long_info =
+        centre_only ? *centreInformation(covariance, turned) : Matrix6d(covariance.inverse());
+    const std::vector<WindowLink> links{{0, 1, truth[0].inverse() * truth[1], info},
+                                        {1, 2, truth[1].inverse() * truth[2], info},
+                                        {0, 2, turned, long_info}};
+    refineWindow(poses, links);
+    const double moved = logSE3(truth[2].inverse() * poses[2]).norm();
+    if (centre_only) {
+      EXPECT_LT(moved, 1e-10);
+      EXPECT_LT(logSE3(truth[1].inverse() * poses[1]).norm(), 1e-10);
+    } else {
+      EXPECT_GT(moved, 1e-3);
+    }
+  }
 }
 
 // The odometry with its window: a rendered hand-held camera (0.6 m/s, Kinect-like noise), so

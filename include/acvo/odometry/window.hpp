@@ -8,6 +8,7 @@
 //   cost = 1/2 sum_links r^T Lambda r,   r = log(T_fixed^-1 T_moving T_hat^-1),   Lambda = -H.
 #pragma once
 
+#include <optional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -29,6 +30,17 @@ struct LinkBetween {
   Matrix6d information = Matrix6d::Zero();
 };
 using WindowLink = LinkBetween<int>;
+
+// The information of a link that says where the moving keyframe's centre lies in the fixed
+// one's frame and nothing of its rotation: the registration's covariance (of a left perturbation
+// of `measured`, as the engine gives it) moved to a right perturbation, d_right = Ad(T_hat^-1)
+// d_left, whose translation is the centre's displacement in the moving keyframe's axes and is
+// not moved by a rotation about that centre; the inverse of that translation's covariance (its
+// marginal: the rotation is left free, not held known); back in r's coordinates,
+//   Lambda = Ad(T_hat^-1)^T diag(0, Sigma_vv^-1) Ad(T_hat^-1).
+// nullopt where that covariance is not positive definite.
+std::optional<Matrix6d> centreInformation(const Matrix6d& covariance,
+                                          const Eigen::Isometry3d& measured);
 
 // r of one link at the given poses (camera -> odometry frame).
 Vector6d linkResidual(const std::vector<Eigen::Isometry3d>& poses, const WindowLink& link);

@@ -53,9 +53,12 @@ void Odometry::linkToOlderKeyframes(OdometryResult& r, const Tracked& frame) {
     // a frame may move.
     const Judgement judgement = judgeTracking(s, guess.inverse() * s.transform, params_.odometry);
     if (judgement.tracking != Tracking::kOk) continue;
+    // It says where the keyframe's centre lies, not how it is turned: on a real camera a
+    // registration across several keyframes errs in rotation with its span, where the chain of
+    // shorter ones does not (its depth's distortion is fixed in the image).
     const std::optional<Matrix6d> covariance = engine_->covariance(s, frame.cloud->size());
     const std::optional<Matrix6d> information =
-        covariance ? scaledInverseInformation(*covariance, 1.0) : std::nullopt;
+        covariance ? centreInformation(*covariance, s.transform) : std::nullopt;
     if (!information) continue;
     links_.push_back({older->index, frame.index, s.transform, *information});
     ++r.window_links;

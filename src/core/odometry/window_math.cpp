@@ -28,6 +28,18 @@ Linearised linearise(const std::vector<Eigen::Isometry3d>& poses, const WindowLi
 
 }  // namespace
 
+std::optional<Matrix6d> centreInformation(const Matrix6d& covariance,
+                                          const Eigen::Isometry3d& measured) {
+  const Matrix6d to_right = adjointSE3(measured.inverse());
+  const Eigen::Matrix3d centre =
+      (to_right * covariance * to_right.transpose()).bottomRightCorner<3, 3>();
+  const Eigen::LLT<Eigen::Matrix3d> llt(0.5 * (centre + centre.transpose()));
+  if (llt.info() != Eigen::Success || !centre.allFinite()) return std::nullopt;
+  Matrix6d right = Matrix6d::Zero();
+  right.bottomRightCorner<3, 3>() = llt.solve(Eigen::Matrix3d::Identity());
+  return to_right.transpose() * right * to_right;
+}
+
 double windowCost(const std::vector<Eigen::Isometry3d>& poses,
                   const std::vector<WindowLink>& links) {
   double cost = 0.0;
