@@ -159,12 +159,13 @@ TEST(Window, ACentreLinkIsAFullLinkWhoseRotationIsUnknown) {
     free_rotation.topLeftCorner<3, 3>() = 1e7 * Eigen::Matrix3d::Identity();
     const Matrix6d limit = (covariance + to_left * free_rotation * to_left.transpose()).inverse();
     EXPECT_LT((limit - *centre).norm(), 1e-5 * centre->norm()) << "trial " << trial;
-    // Not the translation block of the full information (that would hold the rotation known).
+    // Not the translation block of the full information in the right perturbation's coordinates
+    // (that would hold the rotation known).
+    const Matrix6d to_right = to_left.inverse();
     Matrix6d held = Matrix6d::Zero();
     held.bottomRightCorner<3, 3>() =
-        (to_left.inverse().transpose() * covariance.inverse() * to_left.inverse())
-            .bottomRightCorner<3, 3>();
-    EXPECT_GT((to_left.transpose() * held * to_left - *centre).norm(), 0.1 * centre->norm());
+        (to_left.transpose() * covariance.inverse() * to_left).bottomRightCorner<3, 3>();
+    EXPECT_GT((to_right.transpose() * held * to_right - *centre).norm(), 0.1 * centre->norm());
   }
   EXPECT_FALSE(centreInformation(Matrix6d::Zero(), Eigen::Isometry3d::Identity()).has_value());
 }
@@ -180,10 +181,11 @@ TEST(Window, ALinkThatDisagreesOnlyInRotationMovesNoPose) {
   const Eigen::Isometry3d turned = truth[0].inverse() * truth[2] *
                                    expSE3((Vector6d() << 0.02, -0.01, 0.015, 0, 0, 0).finished());
   const Matrix6d covariance = randomInformation(rng).inverse();
+  const std::optional<Matrix6d> centre = centreInformation(covariance, turned);
+  ASSERT_TRUE(centre.has_value());
   for (const bool centre_only : {true, false}) {
     std::vector<Eigen::Isometry3d> poses = truth;
-    const Matrix6d long_info =
-        centre_only ? *centreInformation(covariance, turned) : Matrix6d(covariance.inverse());
+    const Matrix6d long_info = centre_only ? *centre : Matrix6d(covariance.inverse());
     const std::vector<WindowLink> links{{0, 1, truth[0].inverse() * truth[1], info},
                                         {1, 2, truth[1].inverse() * truth[2], info},
                                         {0, 2, turned, long_info}};

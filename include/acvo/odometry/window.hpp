@@ -5,7 +5,9 @@
 // kernel objective F(T), T: moving -> fixed, has its maximum at the registered transform and
 // there the curvature H the engine reports; to second order, F(exp(d) T_hat) = F* + d^T H d / 2.
 // The window maximises the sum of its links' objectives over the poses, i.e. minimises
-//   cost = 1/2 sum_links r^T Lambda r,   r = log(T_fixed^-1 T_moving T_hat^-1),   Lambda = -H.
+//   cost = 1/2 sum_links r^T Lambda r,   r = log(T_fixed^-1 T_moving T_hat^-1),   Lambda = -H,
+// or, for a link to a keyframe older than the one before, only its centre's part
+// (centreInformation).
 #pragma once
 
 #include <optional>

@@ -54,8 +54,8 @@ void Odometry::linkToOlderKeyframes(OdometryResult& r, const Tracked& frame) {
     const Judgement judgement = judgeTracking(s, guess.inverse() * s.transform, params_.odometry);
     if (judgement.tracking != Tracking::kOk) continue;
     // It says where the keyframe's centre lies, not how it is turned: on a real camera a
-    // registration across several keyframes errs in rotation with its span, where the chain of
-    // shorter ones does not (its depth's distortion is fixed in the image).
+    // registration across several keyframes errs in rotation with its span, more than the chain
+    // of shorter ones does (its depth's distortion is fixed in the image).
     const std::optional<Matrix6d> covariance = engine_->covariance(s, frame.cloud->size());
     const std::optional<Matrix6d> information =
         covariance ? centreInformation(*covariance, s.transform) : std::nullopt;

@@ -31,13 +31,14 @@ Linearised linearise(const std::vector<Eigen::Isometry3d>& poses, const WindowLi
 std::optional<Matrix6d> centreInformation(const Matrix6d& covariance,
                                           const Eigen::Isometry3d& measured) {
   const Matrix6d to_right = adjointSE3(measured.inverse());
-  const Eigen::Matrix3d centre =
+  const Eigen::Matrix3d centre_covariance =
       (to_right * covariance * to_right.transpose()).bottomRightCorner<3, 3>();
-  const Eigen::LLT<Eigen::Matrix3d> llt(0.5 * (centre + centre.transpose()));
-  if (llt.info() != Eigen::Success || !centre.allFinite()) return std::nullopt;
-  Matrix6d right = Matrix6d::Zero();
-  right.bottomRightCorner<3, 3>() = llt.solve(Eigen::Matrix3d::Identity());
-  return to_right.transpose() * right * to_right;
+  if (!centre_covariance.allFinite()) return std::nullopt;
+  const Eigen::LLT<Eigen::Matrix3d> llt(0.5 * (centre_covariance + centre_covariance.transpose()));
+  if (llt.info() != Eigen::Success) return std::nullopt;
+  Matrix6d right_information = Matrix6d::Zero();
+  right_information.bottomRightCorner<3, 3>() = llt.solve(Eigen::Matrix3d::Identity());
+  return to_right.transpose() * right_information * to_right;
 }
 
 double windowCost(const std::vector<Eigen::Isometry3d>& poses,
