@@ -13,9 +13,9 @@
 #include <vector>
 
 #include "acvo/cloud/colour_depth_check.hpp"
+#include "acvo/dataset/tum.hpp"
 #include "acvo/odometry/odometry.hpp"
 #include "acvo/params.hpp"
-#include "acvo/dataset/tum.hpp"
 #include "tool_support.hpp"
 
 namespace {
@@ -78,13 +78,13 @@ void noteCamera(const acvo::TumDataset& data) {
   const acvo::Camera& c = data.camera();
   if (data.distortion().any()) {
     const auto& k = data.distortion().coefficients;
-    std::cerr << "acvo_tum: the camera's lens distortion (k1 k2 p1 p2 k3 = " << k[0] << ' '
-              << k[1] << ' ' << k[2] << ' ' << k[3] << ' ' << k[4]
+    std::cerr << "acvo_tum: the camera's lens distortion (k1 k2 p1 p2 k3 = " << k[0] << ' ' << k[1]
+              << ' ' << k[2] << ' ' << k[3] << ' ' << k[4]
               << "): every frame undistorted on loading\n";
   }
   if (acvo::nominalIntrinsics(c, data.distortion())) {
-    std::cerr << "acvo_tum: note: the intrinsics (fx " << c.fx << ", fy " << c.fy << ", cx "
-              << c.cx << ", cy " << c.cy << ") are nominal, not a calibration: exact for a "
+    std::cerr << "acvo_tum: note: the intrinsics (fx " << c.fx << ", fy " << c.fy << ", cx " << c.cx
+              << ", cy " << c.cy << ") are nominal, not a calibration: exact for a "
               << "rendered camera; a real one's may be a few percent off, and acvo's translation "
               << "carries that in full (--camera FILE gives a calibration; fr1, fr2 or fr3, "
               << "TUM's)\n";
@@ -117,7 +117,7 @@ class StatsWriter {
     out_ << "frame,stamp,tracking,status,points,fixed_points,iterations,ell,nnz,matched_fraction,"
             "ms_selection,ms_labels,ms_prepare,ms_cloud,ms_neighbours,ms_registration,ms_frame,"
             "rss_kib,keyframe,new_keyframe,depth_delay_ms,depth_moved,second_start,ms_window,"
-            "window_links,window_shift_mm,window_shift_deg";
+            "ms_window_wait,window_links,window_shift_mm,window_shift_deg";
     for (const auto& name : figures_) out_ << ',' << name;
     out_ << '\n';
   }
@@ -129,11 +129,12 @@ class StatsWriter {
          << s.iterations << ',' << s.ell << ',' << s.nnz << ',' << s.matched_fraction << ','
          << r.cloud_stats.ms_selection << ',' << r.cloud_stats.ms_labels << ',' << r.ms_prepare
          << ',' << r.ms_cloud << ',' << s.ms_neighbours << ',' << r.ms_registration << ','
-         << r.ms_cloud + r.ms_registration + r.ms_window << ',' << acvo::tools::residentKiB() << ','
-         << r.keyframe_index << ',' << int(r.new_keyframe) << ',' << 1e3 * r.depth_delay << ','
-         << (r.depth_retimed ? 2 : int(r.depth_synced)) << ','
+         << r.ms_cloud + r.ms_registration + r.ms_window_wait << ',' << acvo::tools::residentKiB()
+         << ',' << r.keyframe_index << ',' << int(r.new_keyframe) << ',' << 1e3 * r.depth_delay
+         << ',' << (r.depth_retimed ? 2 : int(r.depth_synced)) << ','
          << (r.second_start_kept ? 2 : int(r.second_start)) << ',' << r.ms_window << ','
-         << r.window_links << ',' << 1e3 * r.window_shift << ',' << r.window_shift_deg;
+         << r.ms_window_wait << ',' << r.window_links << ',' << 1e3 * r.window_shift << ','
+         << r.window_shift_deg;
     const auto figures = acvo::engineFigures(s);
     for (const auto& name : figures_) {
       const auto it = std::find_if(figures.begin(), figures.end(),
@@ -162,15 +163,15 @@ std::optional<acvo::OdometryResult> processFrame(acvo::Odometry& odometry,
   }
   const char* line = progress ? "\n" : "";
   if (r.colour_verdict_now) {
-    const bool unregistered = odometry.colourCheck().verdict().state ==
-                              acvo::ColourDepthCheck::State::kUnregistered;
+    const bool unregistered =
+        odometry.colourCheck().verdict().state == acvo::ColourDepthCheck::State::kUnregistered;
     std::cerr << line << "acvo_tum: " << (unregistered ? "warning: " : "")
               << odometry.describeColour() << "\n";
   }
   if (r.tracking == acvo::Tracking::kLost || r.tracking == acvo::Tracking::kBadFrame) {
     std::cerr << line << "acvo_tum: frame " << k << " ("
-              << data.frames()[std::size_t(k)].rgb.stamp_text << "): "
-              << acvo::toString(r.tracking) << ": " << r.message << "\n";
+              << data.frames()[std::size_t(k)].rgb.stamp_text << "): " << acvo::toString(r.tracking)
+              << ": " << r.message << "\n";
   }
   return r;
 }
@@ -190,13 +191,13 @@ Run runFrames(acvo::Odometry& odometry, const acvo::TumDataset& data, long first
   for (long k = first; k < last; ++k) {
     const auto& entry = data.frames()[std::size_t(k)];
     const std::optional<acvo::OdometryResult> r = processFrame(odometry, data, k, progress);
-    run.failures += !r || r->tracking == acvo::Tracking::kLost ||
-                    r->tracking == acvo::Tracking::kBadFrame;
+    run.failures +=
+        !r || r->tracking == acvo::Tracking::kLost || r->tracking == acvo::Tracking::kBadFrame;
     if (!r) continue;
     if (r->tracking != acvo::Tracking::kBadFrame) {
       run.trajectory.push_back({entry.rgb.stamp_text, entry.rgb.stamp, r->pose});
     }
-    const double ms = r->ms_cloud + r->ms_registration + r->ms_window;
+    const double ms = r->ms_cloud + r->ms_registration + r->ms_window_wait;
     if (r->tracking != acvo::Tracking::kFirstFrame) run.frame_ms.push_back(ms);
     stats.write(k, entry.rgb.stamp_text, *r);
     if (progress) {

@@ -1,10 +1,17 @@
-// The local window's cost, gradient and refinement (odometry/window.hpp, docs/method.md §7.7).
+// The local window's cost, gradient and refinement (odometry/window.hpp), its work on a thread of
+// its own (odometry/keyframe_window.hpp) and the odometry with it (docs/method.md §7.7).
+#include <memory>
+#include <mutex>
 #include <optional>
 #include <random>
+#include <set>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include "acvo/cloud/labelled_cloud.hpp"
+#include "acvo/odometry/keyframe_window.hpp"
 #include "acvo/odometry/odometry.hpp"
 #include "acvo/odometry/window.hpp"
 #include "se3_fixtures.hpp"
@@ -198,6 +205,115 @@ TEST(Window, ALinkThatDisagreesOnlyInRotationMovesNoPose) {
       EXPECT_GT(moved, 1e-3);
     }
   }
+}
+
+// An engine that registers as the built-in one does, says whether it is reentrant as told, and
+// records the threads its registrations ran on.
+class RecordingEngine : public RegistrationEngine {
+ public:
+  RecordingEngine(std::shared_ptr<const RegistrationEngine> engine, bool reentrant)
+      : engine_(std::move(engine)), reentrant_(reentrant) {}
+  std::shared_ptr<PreparedCloud> prepare(LabelledCloud cloud, bool as_reference) const override {
+    return engine_->prepare(std::move(cloud), as_reference);
+  }
+  double prepareReference(PreparedCloud& cloud) const override {
+    return engine_->prepareReference(cloud);
+  }
+  using RegistrationEngine::align;
+  SolverResult align(const PreparedCloud& fixed, const PreparedCloud& moving,
+                     const Eigen::Isometry3d& guess, AlignStages stages) const override {
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      threads_.insert(std::this_thread::get_id());
+    }
+    return engine_->align(fixed, moving, guess, stages);
+  }
+  bool staged() const override { return engine_->staged(); }
+  bool reentrant() const override { return reentrant_; }
+  std::optional<Matrix6d> covariance(const SolverResult& s,
+                                     std::size_t moving_points) const override {
+    return engine_->covariance(s, moving_points);
+  }
+  int minPoints() const override { return engine_->minPoints(); }
+  std::set<std::thread::id> threads() const {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    return threads_;
+  }
+
+ private:
+  std::shared_ptr<const RegistrationEngine> engine_;
+  bool reentrant_;
+  mutable std::mutex mutex_;
+  mutable std::set<std::thread::id> threads_;
+};
+
+// Every third frame of a rendered hand-held camera entered as a keyframe, registered to the one
+// before from the true motion; the window's updates, each taken after the next enter()'s caller
+// would have registered a frame.
+std::vector<WindowUpdate> enterKeyframes(const synth::SynthSequence& seq, const Params& p,
+                                         const std::shared_ptr<const RegistrationEngine>& engine) {
+  KeyframeWindow window(4, p.odometry, 1);
+  std::vector<WindowUpdate> updates;
+  WindowKeyframe keyframe;
+  for (int i = 0; i < seq.size(); i += 3) {
+    WindowKeyframe frame;
+    frame.cloud = engine->prepare(buildLabelledCloud(seq.frame(i).toFrame(), p.selection), true);
+    frame.index = std::uint64_t(i);
+    if (!keyframe.cloud) {
+      frame.pose = seq.poses()[0];
+      keyframe = frame;
+      continue;
+    }
+    const Eigen::Isometry3d truth = seq.poses()[std::size_t(keyframe.index)].inverse() *
+                                    seq.poses()[std::size_t(i)];
+    const SolverResult s = engine->align(*keyframe.cloud, *frame.cloud, truth);
+    const std::optional<Matrix6d> covariance = engine->covariance(s, frame.cloud->size());
+    EXPECT_TRUE(covariance.has_value()) << "frame " << i;
+    if (!covariance) break;
+    frame.pose = keyframe.pose * s.transform;
+    window.enter(engine, keyframe, frame, s.transform, *covariance);
+    const std::optional<WindowUpdate> update = window.take();
+    EXPECT_TRUE(update.has_value()) << "frame " << i;
+    if (!update) break;
+    EXPECT_EQ(update->index, frame.index);
+    EXPECT_FALSE(window.take().has_value()) << "an update is taken once";
+    updates.push_back(*update);
+    keyframe = frame;
+    keyframe.pose = update->pose;
+  }
+  window.clear();
+  EXPECT_FALSE(window.take().has_value());
+  return updates;
+}
+
+TEST(KeyframeWindow, ItsWorkRunsOnItsOwnThreadWhereTheEngineAllowsAndGivesTheSamePoses) {
+  synth::SequenceOptions o;
+  o.frames = 22;
+  o.speed = 0.6;
+  const synth::SynthSequence seq(o);
+  Params p;
+  const std::shared_ptr<const RegistrationEngine> built_in = makeRegistrationEngine(p);
+  const auto alongside = std::make_shared<RecordingEngine>(built_in, true);
+  const auto in_take = std::make_shared<RecordingEngine>(built_in, false);
+  const std::vector<WindowUpdate> a = enterKeyframes(seq, p, alongside);
+  const std::vector<WindowUpdate> b = enterKeyframes(seq, p, in_take);
+  // A reentrant engine's registrations ran on the window's thread (besides the caller's own
+  // registrations of the keyframes to each other); the other's on the caller's alone.
+  const std::thread::id caller = std::this_thread::get_id();
+  EXPECT_EQ(alongside->threads().size(), 2U);
+  EXPECT_EQ(in_take->threads(), std::set<std::thread::id>{caller});
+  // The same work either way: the same links and the same refined poses, to the last bit.
+  ASSERT_EQ(a.size(), 7U);
+  ASSERT_EQ(b.size(), a.size());
+  int multi_linked = 0;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    EXPECT_EQ(a[k].links, b[k].links) << "keyframe " << k;
+    EXPECT_TRUE(a[k].pose.isApprox(b[k].pose, 0.0)) << "keyframe " << k;
+    multi_linked += a[k].links > 1;
+  }
+  // The window refined them: keyframes linked to older ones than the one before, and moved.
+  EXPECT_GE(multi_linked, 4);
+  EXPECT_GT(a.back().shift, 0.0);
 }
 
 // The odometry with its window: a rendered hand-held camera (0.6 m/s, Kinect-like noise), so

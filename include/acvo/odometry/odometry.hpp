@@ -6,7 +6,6 @@
 
 #include <cmath>
 #include <cstdint>
-#include <deque>
 #include <memory>
 #include <optional>
 #include <string>
@@ -21,10 +20,10 @@
 #include "acvo/math/se3.hpp"
 #include "acvo/odometry/colour_camera.hpp"
 #include "acvo/odometry/covariance.hpp"
+#include "acvo/odometry/keyframe_window.hpp"
 #include "acvo/odometry/second_start.hpp"
 #include "acvo/odometry/tracking.hpp"
 #include "acvo/odometry/velocity_changes.hpp"
-#include "acvo/odometry/window.hpp"
 #include "acvo/params.hpp"
 #include "acvo/registration/engine.hpp"
 
@@ -78,14 +77,17 @@ struct OdometryResult {
   double ms_cloud = 0.0;
   double ms_prepare = 0.0;
   double ms_registration = 0.0;
-  // The local window (docs/method.md §7.7), when this frame became a keyframe: the time of its
-  // registrations to the older keyframes in the window, its links to older keyframes (the one to
-  // the keyframe it was registered to included), and how far the refinement moved its pose from
-  // where that registration put it (m, deg). `pose` is the refined pose.
+  // The local window (docs/method.md §7.7): its work for the last keyframe, taken up by this
+  // frame (the frame after the keyframe, or the one that lost it): the time of the keyframe's
+  // registrations to the older keyframes in the window (run alongside this frame's where the
+  // engine allows it), its links to older keyframes (the one to the keyframe before included),
+  // how far the refinement moved the keyframe's pose from where it was given out (m, deg), and
+  // how long this frame waited for that work.
   double ms_window = 0.0;
   int window_links = 0;
   double window_shift = 0.0;
   double window_shift_deg = 0.0;
+  double ms_window_wait = 0.0;
   CloudStats cloud_stats;
   // The colour check's verdict became known with this frame (Odometry::colourCheck()), and
   // whether this frame's colour was resampled to the depth camera (from the frame after an
@@ -111,9 +113,11 @@ Frame depthAsRegistered(const Frame& frame, const OdometryResult& r);
 //    driver).
 //  - a lost frame keeps the last good pose (its covariance grows with lostGrowth), drops the
 //    velocity, and replaces the reference by replacesReference.
-//  - local window (odometry.window_keyframes, window.cpp): a frame that becomes a keyframe is
-//    also registered to the older keyframes in the window, and the window's poses are refined
-//    together before its pose is given out; no pose given out changes afterwards.
+//  - local window (odometry.window_keyframes, keyframe_window.hpp): a frame that becomes a
+//    keyframe is given out at the pose its registration put it; then it is registered to the
+//    older keyframes in the window and the window's poses are refined together, while the next
+//    frame is registered, which goes on from the keyframe's refined pose. No pose given out
+//    changes afterwards.
 class Odometry {
  public:
   explicit Odometry(const Params& params = Params());
@@ -186,13 +190,10 @@ class Odometry {
   void tracked(OdometryResult& r, const Registration& reg, double stamp);
   void lost(OdometryResult& r, const Registration& reg, double stamp);
   void lookAtColour(const Frame& frame, OdometryResult& r);
-  // The local window (window.cpp): `frame`, registered to the current keyframe, becomes the
-  // keyframe; in the window, it is registered to the older keyframes too and its pose refined.
+  // `frame`, registered to the current keyframe, becomes the keyframe, and enters the window.
   void newKeyframe(OdometryResult& r, Tracked frame);
-  void enterWindow(OdometryResult& r, Tracked& frame);
-  void linkToOlderKeyframes(OdometryResult& r, const Tracked& frame);
-  void leaveWindow(std::size_t size);
-  void refineWindow(Tracked& frame);
+  // The window's update of the last keyframe's pose, waited for where its work runs yet.
+  void takeWindow(OdometryResult& r);
 
   // The motion between the two frames of the last velocity over `seconds`, and that velocity as
   // a twist per second; none until two frames were tracked.
@@ -208,11 +209,11 @@ class Odometry {
   void makeEngine();
 
   Params params_;
-  std::unique_ptr<RegistrationEngine> engine_;
+  std::shared_ptr<const RegistrationEngine> engine_;  // shared with the window's work
   Eigen::Isometry3d pose_ = Eigen::Isometry3d::Identity();
   Matrix6d pose_covariance_;
   Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();  // last frame-to-frame motion
-  double velocity_interval_ = 0.0;  // s between the two frames of velocity_ (0: unknown)
+  double velocity_interval_ = 0.0;    // s between the two frames of velocity_ (0: unknown)
   VelocityChanges velocity_changes_;  // how the velocity has been changing (second starts)
   // Whether a frame was tracked since the start, the last reset or the last lost frame: until
   // then the constant-velocity guess is the identity, no motion measured.
@@ -220,19 +221,12 @@ class Odometry {
   SecondStart second_start_;
   std::optional<Tracked> keyframe_;
   std::optional<Tracked> last_;  // the last tracked frame (the keyframe itself, or after it)
-  // The local window: its keyframes, oldest first, the current keyframe last (empty without a
-  // window), and the registrations that link them, by frame index.
-  using Link = LinkBetween<std::uint64_t>;
-  std::deque<Tracked> window_;
-  std::vector<Link> links_;
-  // Keyframes that left the window, with their last poses, held fixed while a keyframe in the
-  // window is linked to them.
-  std::vector<std::pair<std::uint64_t, Eigen::Isometry3d>> anchors_;
   int lost_in_a_row_ = 0;
   std::uint64_t frames_ = 0;  // frames numbered so far
   ColourCamera colour_;
   struct Arena;  // the thread pool the solver runs in (odometry.threads)
   std::unique_ptr<Arena> arena_;
+  std::unique_ptr<KeyframeWindow> window_;  // null without a window
 };
 
 }  // namespace acvo

@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "acvo/params.hpp"
-#include "acvo/registration/engine.hpp"
 #include "acvo/registration/direct_terms.hpp"
+#include "acvo/registration/engine.hpp"
 #include "acvo/registration/kernel.hpp"
 
 namespace acvo {
@@ -56,9 +56,9 @@ bool perPointKernel(const CoarseToFineParams& p);
 
 // What one kernel pass sums over the kept pairs at a transform.
 struct LevelSums {
-  double F = 0.0;             // sum a_ij
-  std::int64_t nnz = 0;       // kept pairs
-  std::int64_t matched = 0;   // moving points with at least one kept pair
+  double F = 0.0;            // sum a_ij
+  std::int64_t nnz = 0;      // kept pairs
+  std::int64_t matched = 0;  // moving points with at least one kept pair
   // With the kernel values a_ij held fixed, exp(-u) >= exp(-u0)(1 - (u - u0)) makes
   // sum a_ij u_ij(T) a quadratic whose decrease raises F (a minorise-maximise step, EM-ICP's).
   // H xi = g are its Gauss-Newton normal equations for a left perturbation xi = (omega, v).
@@ -100,8 +100,8 @@ Vector6d extrapolatedStep(const Vector6d& step, const Vector6d& previous, double
 // The engine's steps as functions of values (the engine class below holds the parameters and
 // what it learns of the camera from one registration to the next).
 std::shared_ptr<CoarseToFineCloud> prepareCoarseToFine(LabelledCloud cloud,
-                                                      const CoarseToFineParams& p,
-                                                      bool as_reference);
+                                                       const CoarseToFineParams& p,
+                                                       bool as_reference);
 double prepareCoarseToFineReference(CoarseToFineCloud& cloud, const CoarseToFineParams& p);
 // `stages`: kCoarse the levels before the finest (none when there is one level: the guess comes
 // back), kFinest the finest alone.
@@ -118,6 +118,7 @@ class CoarseToFineEngine : public RegistrationEngine {
   SolverResult align(const PreparedCloud& fixed, const PreparedCloud& moving,
                      const Eigen::Isometry3d& guess, AlignStages stages) const override;
   bool staged() const override { return true; }
+  bool reentrant() const override { return true; }
   // covariance_scale (-H)^-1: the information weighs each point by its own kernel, whatever
   // the number of its pairs.
   std::optional<Matrix6d> covariance(const SolverResult& s,

@@ -16,8 +16,8 @@
 #include <Eigen/Geometry>
 
 #include "acvo/cloud/labelled_cloud.hpp"
-#include "acvo/params.hpp"
 #include "acvo/math/se3.hpp"
+#include "acvo/params.hpp"
 
 namespace acvo {
 
@@ -126,6 +126,9 @@ class RegistrationEngine {
     return align(fixed, moving, guess, AlignStages::kAll);
   }
   virtual bool staged() const = 0;
+  // Whether registrations may run on two threads at once: the engine keeps nothing from one
+  // registration to the next (Odometry's window registers alongside the next frame where so).
+  virtual bool reentrant() const = 0;
   // Covariance of a registered motion (T: moving -> fixed, in the fixed frame's axes); nullopt
   // when the result does not constrain every direction.
   virtual std::optional<Matrix6d> covariance(const SolverResult& s,

@@ -61,6 +61,7 @@ class PaperEngine : public RegistrationEngine {
   SolverResult align(const PreparedCloud& fixed, const PreparedCloud& moving,
                      const Eigen::Isometry3d& guess, AlignStages stages) const override;
   bool staged() const override { return false; }
+  bool reentrant() const override { return false; }  // it carries the length-scale
   // covariance_scale * (pairs per point) * (-H)^-1: neighbouring pairs of one point are far
   // from independent measurements, the information comes from the moving points.
   std::optional<Matrix6d> covariance(const SolverResult& s,
@@ -69,8 +70,8 @@ class PaperEngine : public RegistrationEngine {
 
  private:
   PaperParams params_;
-  // The final length-scale of the last registration (carry_ell); the odometry registers one
-  // frame at a time, so this state is never shared between threads.
+  // The final length-scale of the last registration (carry_ell): registrations run one at a
+  // time (reentrant()).
   mutable double carried_ell_ = 0.0;
 };
 

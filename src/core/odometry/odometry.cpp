@@ -13,10 +13,7 @@
 namespace acvo {
 
 struct Odometry::Arena {
-  explicit Arena(int threads)
-      : arena(threads > 0    ? threads
-              : threads == 0 ? int(tbb::task_arena::automatic)
-                             : std::max(1, tbb::this_task_arena::max_concurrency() - 1)) {}
+  explicit Arena(int threads) : arena(solverThreads(threads)) {}
   tbb::task_arena arena;
 };
 
@@ -63,6 +60,10 @@ Odometry::Odometry(const Params& params)
       colour_(params.odometry.unregistered_colour),
       arena_(std::make_unique<Arena>(params.odometry.threads)) {
   makeEngine();
+  const auto window = std::size_t(std::max(params.odometry.window_keyframes, 0));
+  if (window > 2 && params.odometry.reference == Reference::kKeyframe) {
+    window_ = std::make_unique<KeyframeWindow>(window, params.odometry, params.odometry.threads);
+  }
 }
 Odometry::~Odometry() = default;
 Odometry::Odometry(Odometry&&) noexcept = default;
@@ -106,6 +107,7 @@ OdometryResult Odometry::track(const Frame& frame,
   const Eigen::Isometry3d prior = guess(motion_guess, facts);
   // 3. The registration to the keyframe, or to the last tracked frame where that fails.
   Registration reg = registerFrame(r, frame, current, prior, facts);
+  takeWindow(r);
   // 4. The pose, the keyframe and what the next frame starts from. A lost frame's motion moves
   // no depth: its cloud is kept as built (it may become the reference).
   if (reg.judgement.tracking == Tracking::kLost) reg.moving = current;
@@ -178,9 +180,8 @@ Odometry::Registration Odometry::registerFrame(OdometryResult& r, const Frame& f
                                                const GuessFacts& facts) {
   const bool last_is_keyframe = last_->index == keyframe_->index;
   // From the keyframe: where the last tracked frame was, then the prior's motion.
-  Registration reg = registerTo(*keyframe_, current,
-                                last_is_keyframe ? prior : last_->to_keyframe * prior, frame, r,
-                                facts);
+  Registration reg = registerTo(
+      *keyframe_, current, last_is_keyframe ? prior : last_->to_keyframe * prior, frame, r, facts);
   r.ms_registration = reg.solver.ms_total;
 
   // Failed against the keyframe: the last tracked frame, closer in time, may still overlap.
@@ -231,9 +232,8 @@ Odometry::Registration Odometry::registerTo(const Tracked& reference,
   return reg;
 }
 
-SolverResult Odometry::alignStaged(const Tracked& reference, Registration& reg,
-                                   const Frame& frame, const Eigen::Isometry3d& guess,
-                                   OdometryResult& r) {
+SolverResult Odometry::alignStaged(const Tracked& reference, Registration& reg, const Frame& frame,
+                                   const Eigen::Isometry3d& guess, OdometryResult& r) {
   const PreparedCloud& fixed = *reference.cloud;
   const bool retimes = params_.odometry.sync_depth == SyncDepth::kOwnMotion &&
                        r.depth_delay != 0.0 && r.interval > 0.0 && engine_->staged();
@@ -249,9 +249,8 @@ SolverResult Odometry::alignStaged(const Tracked& reference, Registration& reg,
   const Eigen::Isometry3d before =
       r.depth_synced ? motionOver(r.depth_delay).value_or(Eigen::Isometry3d::Identity())
                      : Eigen::Isometry3d::Identity();
-  if (std::optional<LabelledCloud> again =
-          retimedCloud(reg.moving->cloud, frame, before, expSE3(velocity * r.depth_delay),
-                       params_.selection)) {
+  if (std::optional<LabelledCloud> again = retimedCloud(
+          reg.moving->cloud, frame, before, expSE3(velocity * r.depth_delay), params_.selection)) {
     reg.moving = engine_->prepare(std::move(*again), reg.moving->reference);
     r.ms_cloud += msSince(t0);
   }
@@ -294,10 +293,10 @@ void Odometry::tracked(OdometryResult& r, const Registration& reg, double stamp)
   const bool last_is_keyframe = last_->index == keyframe.index;
   r.motion = last_is_keyframe ? to_keyframe : last_->to_keyframe.inverse() * to_keyframe;
   r.registration_covariance = reg.covariance;
-  r.motion_covariance =
-      last_is_keyframe ? reg.covariance
-                       : frameMotionCovariance(last_->to_keyframe,
-                                               last_->to_keyframe_covariance, reg.covariance);
+  r.motion_covariance = last_is_keyframe
+                            ? reg.covariance
+                            : frameMotionCovariance(last_->to_keyframe,
+                                                    last_->to_keyframe_covariance, reg.covariance);
   pose_ = normalized(keyframe.pose * to_keyframe);
   pose_covariance_ = keyframe.covariance + rotateCovariance(reg.covariance, keyframe.pose.linear());
   r.pose = pose_;
@@ -317,7 +316,6 @@ void Odometry::tracked(OdometryResult& r, const Registration& reg, double stamp)
       takesKeyframe(reg.judgement, reg.solver, params_.odometry)) {
     frame.cloud = asReference(r, reg.moving);
     newKeyframe(r, std::move(frame));
-    pose_ = r.pose = keyframe_->pose;  // refined in the window (when there is one)
     last_ = keyframe_;
     r.new_keyframe = true;
     return;
@@ -340,9 +338,9 @@ void Odometry::lost(OdometryResult& r, const Registration& reg, double stamp) {
                         params_)) {
     // The held pose with what it may be wrong by: the next frames are registered from here.
     pose_covariance_ = r.pose_covariance;
-    keyframe_ = last_ = Tracked{asReference(r, reg.moving), r.frame_index, pose_,
-                                pose_covariance_, Eigen::Isometry3d::Identity()};
-    window_.clear();  // nothing links the new reference to the window's keyframes
+    keyframe_ = last_ = Tracked{asReference(r, reg.moving), r.frame_index, pose_, pose_covariance_,
+                                Eigen::Isometry3d::Identity()};
+    if (window_) window_->clear();  // nothing links the new reference to the window's keyframes
     r.new_keyframe = true;
   }
 }
@@ -357,7 +355,7 @@ void Odometry::reset(const Eigen::Isometry3d& pose, const Matrix6d& covariance) 
   second_start_.forget();
   keyframe_.reset();
   last_.reset();
-  window_.clear();
+  if (window_) window_->clear();
   lost_in_a_row_ = 0;
 }
 
