@@ -169,12 +169,13 @@ struct OdometryParams {
   double keyframe_matched_fraction = 0.5;
   double keyframe_translation = 0.05;  // m
   double keyframe_rotation = 2.0;      // deg
-  // keyframe only: the local window (odometry/window.hpp, docs/method.md §7.7). Each new keyframe
-  // is also registered to the older keyframes in the window, and the window's poses are refined
-  // together over those registrations; the frames after it go on from its refined pose. The
-  // number of keyframes in the window, the new one included; 0 to 2: no window, each keyframe's
-  // pose from its registration to the one before alone.
-  int window_keyframes = 0;
+  // keyframe only: the local window (odometry/keyframe_window.hpp, docs/method.md §7.7). Each
+  // new keyframe is also registered to the older keyframes in the window, and the window's poses
+  // are refined together over those registrations, while the next frame is registered; the
+  // frames after it go on from its refined pose. The number of keyframes in the window, the new
+  // one included; 0 to 2: no window, each keyframe's pose from its registration to the one
+  // before alone.
+  int window_keyframes = 4;
   int threads = -1;  // -1 = all cores but one (a camera driver keeps a core), 0 = all, n = n
   // Tracking judgement (see odometry.hpp): lost when fewer than this fraction of the frame's
   // points found a kernel partner at the solution (nothing in common), or when a frame-to-frame

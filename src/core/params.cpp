@@ -298,6 +298,7 @@ Params paperParams() {
   // and 6% in rotation: docs/method.md §4).
   p.selection.max_depth = 100.0;
   p.odometry.reference = Reference::kPreviousFrame;  // the paper's frame-to-frame driver
+  p.odometry.window_keyframes = 0;                    // and no window of keyframes
   // The authors' driver integrates every estimate: a frame is lost only when the registration
   // failed or the motion is implausible, never for a low overlap.
   p.odometry.lost_matched_fraction = 0.0;

@@ -51,11 +51,11 @@ CONFIG = os.path.join(os.path.dirname(os.path.realpath(__file__)), "test_params.
 # The figures beside the bounds are what scripts/measure_ros_bounds printed (it runs the .test
 # files of this driver and reads their [ BOUND ] lines).
 # Worst error of a base pose relative to the first over the sequence (30 frames at 10 Hz,
-# 0.3 m/s, Kinect-like noise), per bag: the freenect one 0.00297 m, 0.00126 rad (robot_frames,
-# freenect_bag, guess_bag's prior run, loop_bag's first pass) and 0.00341 m, 0.00138 rad
-# (loop_bag's second pass, which may start a frame later); the realsense one 0.00146 m,
-# 0.000728 rad. The bounds are 2.5x the larger and at most 2.9x the smaller.
-TOLERANCE = {"freenect": (0.0085, 0.0035), "realsense": (0.0037, 0.0018)}  # m, rad
+# 0.3 m/s, Kinect-like noise), per bag: the freenect one 0.001258 m, 0.000601 rad (robot_frames,
+# freenect_bag, guess_bag's prior run, loop_bag's first pass) and 0.001479 m, 0.000670 rad
+# (loop_bag's second pass, which may start a frame later); the realsense one 0.000902 m,
+# 0.000460 rad. The bounds are 2.5x the larger and at most 2.9x the smaller.
+TOLERANCE = {"freenect": (0.0037, 0.00167), "realsense": (0.00226, 0.00115)}  # m, rad
 # Frames that must come out when the bag is played at PLAY_RATE with the launch files' default
 # queues (2 per topic: a frame arriving while one is processed replaces the older one).
 MIN_PUBLISHED = 0.6
@@ -425,13 +425,13 @@ class RobotBagTest(unittest.TestCase):
 # Guess, as scripts/measure_ros_bounds printed it (guess_bag.test; acvo.launch's defaults):
 # iterations per frame 10.18 with the constant-velocity prior, 8.64 with the exact guess, 9.36
 # with the biased one (coarse-to-fine takes a few iterations per level even from the answer):
-# 1.54 fewer with the exact guess, bounded below at 1 (2/3 of it). Worst errors 0.002970 m,
-# 0.001257 rad (prior), 0.002970 m, 0.001259 rad (exact), 0.002981 m, 0.001263 rad (biased): the
-# registrations converge to nearly the same optimum, the exact guess 5.8e-7 m and 1.13e-6 rad
-# from the prior's, the biased one 1.11e-5 m and 5.5e-6 rad. The bounds on those differences
+# 1.54 fewer with the exact guess, bounded below at 1 (2/3 of it). Worst errors 0.001258 m,
+# 0.000601 rad (prior), 0.001259 m, 0.000602 rad (exact), 0.001260 m, 0.000603 rad (biased): the
+# registrations converge to nearly the same optimum, the exact guess 6.8e-7 m and 8.9e-7 rad
+# from the prior's, the biased one 1.70e-6 m and 1.66e-6 rad. The bounds on those differences
 # are 2.5x each.
 FEWER_ITERATIONS = 1.0  # per frame
-SAME = {"exact": (1.5e-6, 2.8e-6), "biased": (2.8e-5, 1.4e-5)}  # m, rad
+SAME = {"exact": (1.7e-6, 2.2e-6), "biased": (4.25e-6, 4.15e-6)}  # m, rad
 
 
 if __name__ == "__main__":
