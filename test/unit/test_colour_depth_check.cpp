@@ -221,7 +221,7 @@ TEST(ColourDepthCheck, AColourCameraIsFoundThroughMotionBlur) {
 //   ratio's, the gain's and the frames' conditions and fits one quarter of the image only (1.01x
 //   in all quarters but one): the quarters tell it (and its focal ratio alone near it, 1.18, lies
 //   at the grid's end).
-// - At 1 m/s with the colour 10 ms late (p6), the best camera is 0.98 and -2 cm here (1.33x),
+// - At 1 m/s with the colour 10 ms late (p6), the best camera is 0.98 and -2 cm here (1.34x),
 //   within 0.04 of ratio 1. From p6's folder as acvo_synth writes it (its images in PNG),
 //   acvo_tum finds 0.96 and -3 cm (1.31x; 1.19x in all quarters but one), whose focal ratio alone
 //   near it, 0.99, tells it.

@@ -21,10 +21,14 @@ constexpr double kChi2Six95 = 12.5916;
 
 // NEES of each registration: the motion from the frame's camera to its keyframe's (the
 // previous frame's with the previous_frame reference) against the exact one, with the
-// reported registration_covariance (odometry.hpp).
+// reported registration_covariance (odometry.hpp). Without the local window: it moves a
+// keyframe's pose after it is given out, and the frames after it go on from the moved pose, so
+// their poses would carry the window's correction besides their registration's error.
 std::vector<double> neesOf(const synth::SequenceOptions& o, int* lost) {
   const synth::SynthSequence seq(o);
-  Odometry odo;
+  Params params;
+  params.odometry.window_keyframes = 0;
+  Odometry odo(params);
   std::vector<double> nees;
   std::vector<Eigen::Isometry3d> estimate;
   for (int i = 0; i < seq.size(); ++i) {
