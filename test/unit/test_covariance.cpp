@@ -150,8 +150,8 @@ TEST_P(Covariance, NormalisedErrorsAreConsistentWithTheReportedCovariance) {
       nees.size(), lost, 100 * inside, nees[nees.size() / 2],
       nees[size_t(0.95 * double(nees.size()))]);
   // With the last level's direct terms (measured): the textured room 100% inside, median NEES
-  // 0.51 (the covariance about 3x the error's spread: conservative); the flat-coloured room
-  // 74.5% inside, median 6.2 against chi2_6's 5.35, its tail heavier (the renderer's flat
+  // 1.32 (the covariance about 2x the error's spread: conservative); the flat-coloured room
+  // 82.6% inside, median 6.1 against chi2_6's 5.35, its tail heavier (the renderer's flat
   // colours meet at pixel-quantised edges, the only grey values that carry its motion).
   // Bounds: no more than 30% of the errors outside, and a median neither 20x below chi2_6's
   // (uselessly conservative) nor 2x above (over-confident).

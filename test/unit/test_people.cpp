@@ -26,7 +26,7 @@ TEST(Sequences, APersonCrossingTheViewIsNotMistakenForTheCamerasMotion) {
   const synth::SynthSequence seq(o);
   Params one_start;
   one_start.odometry.second_start = false;
-  // Measured 0.00020 m/s, 0.0044 deg/s with the second start and 0.43386, 5.8995 with one start
+  // Measured 0.00020 m/s, 0.0044 deg/s with the second start and 0.434, 5.90 with one start
   // (with one keyframe and no window: 0.00032, 0.0060 and 0.469, 6.73; 0.00028, 0.0106 with the
   // photometric term's forward direction alone; the room without the person: 0.0002, 0.005 over
   // 300 frames; with Huber's weight in the direct terms, where the person's residuals kept

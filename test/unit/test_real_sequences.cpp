@@ -69,7 +69,7 @@ TEST(Sequences, RpeOnRealKinectFrames) {
   }
   // Measured 0.0112 m/s, 0.462 deg/s (default: its colour found unregistered at the third frame,
   // then resampled and the last level led by the depth, unregistered_colour resample_depth_led;
-  // with one keyframe and no window: 0.0123, 0.557; 0.0565, 2.387 with resample alone; 0.0136,
+  // 0.0594, 2.477 with resample alone; with one keyframe and no window 0.0123, 0.557, and 0.0136,
   // 0.710 with the verdict at the tenth frame); paper.yaml 0.0628 m/s, 4.479 deg/s; cvo.yaml
   // 0.0893, 5.474. Bounds 1.1x.
   // 7-Scenes colour and depth come from two unregistered cameras.
