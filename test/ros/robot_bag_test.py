@@ -54,7 +54,7 @@ CONFIG = os.path.join(os.path.dirname(os.path.realpath(__file__)), "test_params.
 # 0.3 m/s, Kinect-like noise), per bag: the freenect one 0.001258 m, 0.000601 rad (robot_frames,
 # freenect_bag, guess_bag's prior run, loop_bag's first pass) and 0.001479 m, 0.000670 rad
 # (loop_bag's second pass, which may start a frame later); the realsense one 0.000902 m,
-# 0.000460 rad. The bounds are 2.5x the larger and at most 2.9x the smaller.
+# 0.000460 rad. The bounds are 2.5x the larger and at most 3x the smaller.
 TOLERANCE = {"freenect": (0.0037, 0.00167), "realsense": (0.00226, 0.00115)}  # m, rad
 # Frames that must come out when the bag is played at PLAY_RATE with the launch files' default
 # queues (2 per topic: a frame arriving while one is processed replaces the older one).

@@ -676,7 +676,8 @@ TEST(OdometryNodelet, TracksKnownMotionWithRightFramesCovarianceAndTf) {
   EXPECT_GT(keyframes, 1) << "the camera moves on: the keyframe changes";
   expectMeasured("twist of a tracked frame, worst off the true velocity", worst_twist,
                  kTwistMeasured, "m/s");
-  expectPoseNear(out.back().odom->pose.pose, client->expectedBase(cameraPose(kTrackFrames - 1)), Measured{0.0000475, 0.0000203}, "final pose");
+  expectPoseNear(out.back().odom->pose.pose, client->expectedBase(cameraPose(kTrackFrames - 1)),
+                 Measured{0.0000475, 0.0000203}, "final pose");
 
   const auto tf = client->lookup(stamps.back());
   ASSERT_TRUE(tf) << client->odom_frame_ << " -> " << client->base_frame_ << " not in TF";
@@ -889,8 +890,8 @@ TEST(OdometryNodelet, EveryOtherFrameMissingIsTrackedAndEveryFrameIsPublished) {
         << out[i].info->tracking << ": " << out[i].info->message;
   }
   // The budget is per frame of motion (12 frames' worth in 6 registrations).
-  expectPoseNear(out.back().odom->pose.pose, client->expectedBase(cameraPose(kLast)), Measured{0.0000320, 0.0000132},
-                 "every other frame missing, final pose");
+  expectPoseNear(out.back().odom->pose.pose, client->expectedBase(cameraPose(kLast)),
+                 Measured{0.0000320, 0.0000132}, "every other frame missing, final pose");
 }
 
 // One second of blank frames at 10 Hz while the camera moves on (frames 4-13: 15 cm, 6 deg),
@@ -1052,8 +1053,8 @@ TEST(OdometryNodelet, WithAGuessTheBlackoutFollowsTheWheelsAndRecoversWithoutAJu
   EXPECT_LT((step.translation() - true_step.translation()).norm(), 1e-6);
   // And the whole run is where the wheels say: nothing of the blackout's motion is lost.
   const int last = int(out.size()) - 1;
-  expectPoseNear(out[last].odom->pose.pose, origin.inverse() * wheels[last], Measured{0.00000264, 0.00000068},
-                 "end of a blackout bridged by the wheels");
+  expectPoseNear(out[last].odom->pose.pose, origin.inverse() * wheels[last],
+                 Measured{0.00000264, 0.00000068}, "end of a blackout bridged by the wheels");
 }
 
 // One frame of noise (random colour and depth) inside a sequence.

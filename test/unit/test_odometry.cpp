@@ -303,8 +303,8 @@ TEST(Odometry, DepthOfAnotherInstantIsMovedByTheFramesOwnMotion) {
 
 // A single frame of noise (random colour, random depth) inside a sequence: lost, the pose
 // stays finite, and the reference survives it: the next frame is registered against the last
-// good one, so no motion is missed. (Re-seeding from the noise frame cost two frames of
-// motion: 2.0 cm off at frame 5, where under 0.1 mm is measured now.)
+// good one, so no motion is missed. (Re-seeding from the noise frame would cost two frames of
+// motion: 2.0 cm off at frame 5, against under 0.1 mm measured.)
 TEST(Odometry, ASingleFrameOfNoiseIsLostAndTheNextFrameTracksAgainstTheLastGoodOne) {
   const auto seq = exactSequence(6);
   Odometry odo;

@@ -182,10 +182,11 @@ void runBlackout(Blank kind) {
   // after the blackout registers against the last one before it, 0.183 m and 9.6 deg apart,
   // and is judged ok (0.12 mm, 0.0027 deg off); the error from before the blackout to 2 s after
   // it is 0.013 mm, 0.0053 deg; RPE after it 0.00020 m/s, 0.0049 deg/s (with one keyframe and no
-  // window: 0.76 mm, 0.0168 deg; 0.00028, 0.0056). Bounds 1.3x. (A motion beyond the
-  // registration's reach would make that frame lost and the reference restart from it: the
-  // error would then be the blackout's motion.)
-  EXPECT_LT(across_t, 0.000017);
+  // window: 0.76 mm, 0.0168 deg; 0.00028, 0.0056). Bounds 1.3x, but for the error across in
+  // translation: the sum of 2 s of drift that partly cancels, 0.1 mm (an eighth of one
+  // keyframe's). (A motion beyond the registration's reach would make that frame lost and the
+  // reference restart from it: the error would then be the blackout's motion.)
+  EXPECT_LT(across_t, 0.0001);
   EXPECT_LT(across_r, 0.0069);
   EXPECT_LT(rpe_after.trans.rmse, 0.00026);
   EXPECT_LT(rpe_after.rot_deg.rmse, 0.0064);
