@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <stdexcept>
 
 #include "tool_support.hpp"
@@ -77,10 +78,17 @@ void evaluateRows(std::vector<CompareRow>& rows, const std::optional<Trajectory>
   double at = offset.value_or(0.0);
   std::string refused;
   if (!offset && reference) {
+    // Every method one vote: each of its rows (settings, thread counts) 1/K of it.
+    std::map<std::string, int> rows_of;
+    for (const auto& row : rows) ++rows_of[row.method];
     std::vector<Trajectory> trajectories;
-    for (const auto& row : rows) trajectories.push_back(row.trajectory);
+    std::vector<double> weights;
+    for (const auto& row : rows) {
+      trajectories.push_back(row.trajectory);
+      weights.push_back(1.0 / rows_of[row.method]);
+    }
     try {
-      at = estimateClockOffset(*reference, trajectories).offset;
+      at = estimateClockOffset(*reference, trajectories, 0.05, weights).offset;
       notes.push_back("# " + name + ": the frames' stamps " + milliseconds(at) +
                       " against the reference's (--offset auto)");
     } catch (const std::exception& e) {

@@ -314,6 +314,24 @@ TEST(ClockOffset, AMethodThatLostItsWayDoesNotMoveIt) {
   EXPECT_GT(c.turn_rms_deg[1], 10.0 * c.turn_rms_deg[0]);
 }
 
+TEST(ClockOffset, WeightsGiveEachMethodOneVote) {
+  // One method's estimate 8 ms off, another's three settings 16 ms off, all equally precise:
+  // counted as four curves the offset leans to the three, (8 + 3 x 16) / 4 = 14 ms; weighted
+  // 1/3 each they are one vote, (8 + 16) / 2 = 12 ms.
+  const acvo::Trajectory gt = acvo::test::sampledCamera(100.0, 6.0, 0.0);
+  std::vector<acvo::Trajectory> estimates{acvo::test::sampledCamera(30.0, 6.0, 0.008, 0.05, 1)};
+  for (unsigned seed = 2; seed <= 4; ++seed) {
+    estimates.push_back(acvo::test::sampledCamera(30.0, 6.0, 0.016, 0.05, seed));
+  }
+  EXPECT_NEAR(acvo::estimateClockOffset(gt, estimates).offset, 0.014, 1e-3);
+  const std::vector<double> one_vote{1.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0};
+  EXPECT_NEAR(acvo::estimateClockOffset(gt, estimates, 0.05, one_vote).offset, 0.012, 1e-3);
+  // One positive weight per estimate, or none.
+  EXPECT_THROW(acvo::estimateClockOffset(gt, estimates, 0.05, {1.0, 1.0}), std::invalid_argument);
+  EXPECT_THROW(acvo::estimateClockOffset(gt, estimates, 0.05, {1.0, 0.0, 1.0, 1.0}),
+               std::invalid_argument);
+}
+
 TEST(ClockOffset, RefusedWhereItCannotShow) {
   const acvo::Trajectory gt = acvo::test::sampledCamera(100.0, 6.0, 0.0);
   const acvo::Trajectory frames = acvo::test::sampledCamera(30.0, 6.0, 0.01);
@@ -321,6 +339,13 @@ TEST(ClockOffset, RefusedWhereItCannotShow) {
   const acvo::Trajectory per_frame = acvo::test::sampledCamera(30.0, 6.0, 0.0);
   EXPECT_NE(acvo::test::errorOf([&] { acvo::estimateClockOffset(per_frame, {frames}); })
                 .find("twice as often"),
+            std::string::npos);
+  // The same reference with every 2nd frame kept (acvo_compare --stride 2): sampled twice as
+  // often as the frames now, and still without a clock of its own.
+  acvo::Trajectory every_2nd;
+  for (std::size_t k = 0; k < per_frame.size(); k += 2) every_2nd.push_back(per_frame[k]);
+  EXPECT_NE(acvo::test::errorOf([&] { acvo::estimateClockOffset(per_frame, {every_2nd}); })
+                .find("the reference's own"),
             std::string::npos);
   // A still camera: every offset fits as well.
   acvo::Trajectory still_gt = gt, still = frames;

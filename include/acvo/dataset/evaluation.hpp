@@ -86,15 +86,19 @@ struct ClockOffset {
 // Searches [-max_offset, max_offset] (0.5 ms steps, then a parabola through the best three).
 // Each estimate's mean square turn error, as a function of the offset, is divided by its own
 // least value before they are summed: a method that lost its way has a flat curve and adds
-// little, a precise one a sharp minimum. Only turns whose reference exists at every offset
-// searched are compared (no gap over twice the median reference interval). Throws
-// std::runtime_error when the reference is not sampled at least twice as often as the frames
-// (median intervals; a reference of one pose per frame, as 7-Scenes' and the synthetic
-// sequences', has no clock of its own), when fewer than 10 turns can be compared, when the best
-// offset is at the search's edge, or when the reference turns too little for the offset to show
-// (the curve's ends within 5% of its least value).
+// little, a precise one a sharp minimum. `weights` (one per estimate, positive; empty: 1 each)
+// scale the curves in the sum: 1/K for each of a method's K settings gives every method one
+// vote, however many settings it ran in (acvo_compare). Only turns whose reference exists at
+// every offset searched are compared (no gap over twice the median reference interval). Throws
+// std::invalid_argument for weights of another count or not positive, and std::runtime_error
+// where the reference has no clock of its own: it is not sampled at least twice as often as the
+// frames (median intervals; a reference of one pose per frame, as 7-Scenes' and the synthetic
+// sequences'), or more than 90% of an estimate's stamps are reference stamps to 0.1 ms (such a
+// reference with the frames kept one in K); also when fewer than 10 turns can be compared, when
+// the best offset is at the search's edge, or when the reference turns too little for the offset
+// to show (the curve's ends within 5% of its least value).
 ClockOffset estimateClockOffset(const Trajectory& groundtruth,
-                                const std::vector<Trajectory>& estimates,
-                                double max_offset = 0.05);
+                                const std::vector<Trajectory>& estimates, double max_offset = 0.05,
+                                const std::vector<double>& weights = {});
 
 }  // namespace acvo

@@ -26,6 +26,8 @@ constexpr double kOffsetStep = 5e-4;        // s, the search's grid
 constexpr std::size_t kMinTurns = 10;       // turns compared, at least
 constexpr double kObservableRise = 1.05;    // the curve's ends over its least value, at least
 constexpr double kReferenceRateRatio = 0.5;  // the reference's interval over the frames', at most
+constexpr double kSameInstant = 1e-4;       // s: a reference stamp this close is a frame's own
+constexpr double kOwnStampsShare = 0.9;     // frames at reference stamps, at most (of all)
 
 // The reference sorted by stamp, its stamps and their median interval.
 struct Reference {
@@ -117,39 +119,64 @@ Reference referenceOf(const Trajectory& groundtruth) {
   return ref;
 }
 
+// How many of the estimate's stamps a reference stamp lies within kSameInstant of.
+std::size_t atReferenceStamps(const Trajectory& est, const Reference& ref) {
+  std::size_t n = 0;
+  for (const StampedPose& p : est) {
+    const auto after = std::lower_bound(ref.stamps.begin(), ref.stamps.end(), p.stamp);
+    const bool at_after = after != ref.stamps.end() && *after - p.stamp <= kSameInstant;
+    const bool at_before = after != ref.stamps.begin() && p.stamp - *(after - 1) <= kSameInstant;
+    n += at_after || at_before ? 1 : 0;
+  }
+  return n;
+}
+
 // The estimates sorted by stamp. Between a reference's samples its turn is an interpolation:
 // sampled no faster than the frames, the offset found would be the one at which the
-// interpolation smooths best; throws there.
+// interpolation smooths best; throws there. A reference whose poses carry the frames' own
+// stamps (one pose per recorded frame, as 7-Scenes'; its frames kept one in K, `--stride`) has
+// no clock of its own either, however often it is sampled against the frames kept; throws too.
 std::vector<Trajectory> sortedEstimates(const std::vector<Trajectory>& estimates,
                                         const Reference& ref) {
   std::vector<Trajectory> sorted;
   for (const Trajectory& trajectory : estimates) {
     sorted.push_back(byStamp(trajectory));
+    if (sorted.back().size() <= 2) continue;
     const double frame_interval = medianInterval(stampsOf(sorted.back()));
-    if (sorted.back().size() > 2 && !(ref.interval <= kReferenceRateRatio * frame_interval)) {
+    if (!(ref.interval <= kReferenceRateRatio * frame_interval)) {
       throw std::runtime_error(
           "clock offset: the reference is sampled every " + std::to_string(ref.interval) +
           " s, not at least twice as often as the frames (every " +
           std::to_string(frame_interval) + " s): its clock cannot be told from its frames'");
     }
+    const std::size_t own = atReferenceStamps(sorted.back(), ref);
+    if (double(own) > kOwnStampsShare * double(sorted.back().size())) {
+      throw std::runtime_error("clock offset: " + std::to_string(own) + " of the " +
+                               std::to_string(sorted.back().size()) +
+                               " frames' stamps are the reference's own: a reference of one "
+                               "pose per frame has no clock of its own");
+    }
   }
   return sorted;
 }
 
-// The estimates' turn error curves, each divided by its own least value, summed; `turns` counts
-// the turns compared. Throws where fewer than kMinTurns turns or no estimate contribute.
+// The estimates' turn error curves, each divided by its own least value, weighted and summed;
+// `turns` counts the turns compared. Throws where fewer than kMinTurns turns or no estimate
+// contribute.
 std::vector<double> summedCurve(const Reference& ref, const std::vector<Trajectory>& sorted,
-                                int half, double max_offset, std::size_t& turns) {
+                                const std::vector<double>& weights, int half, double max_offset,
+                                std::size_t& turns) {
   std::vector<double> total(2 * std::size_t(half) + 1, 0.0);
   std::size_t contributing = 0;
-  for (const Trajectory& est : sorted) {
+  for (std::size_t e = 0; e < sorted.size(); ++e) {
     std::size_t est_turns = 0;
-    const std::vector<double> sum = turnErrorCurve(ref, est, half, est_turns);
+    const std::vector<double> sum = turnErrorCurve(ref, sorted[e], half, est_turns);
     turns += est_turns;
     const double least = *std::min_element(sum.begin(), sum.end());
     // Nothing to compare, or a copy of the reference.
     if (est_turns == 0 || !(least > 0.0)) continue;
-    for (std::size_t g = 0; g < total.size(); ++g) total[g] += sum[g] / least;
+    const double weight = weights.empty() ? 1.0 : weights[e];
+    for (std::size_t g = 0; g < total.size(); ++g) total[g] += weight * sum[g] / least;
     ++contributing;
   }
   if (turns < kMinTurns || contributing == 0) {
@@ -185,13 +212,20 @@ void addTurnRms(const Reference& ref, const std::vector<Trajectory>& sorted, Clo
 }  // namespace
 
 ClockOffset estimateClockOffset(const Trajectory& groundtruth,
-                                const std::vector<Trajectory>& estimates, double max_offset) {
+                                const std::vector<Trajectory>& estimates, double max_offset,
+                                const std::vector<double>& weights) {
   const Reference ref = referenceOf(groundtruth);
   const int half = int(std::lround(max_offset / kOffsetStep));
   if (half < 1) throw std::runtime_error("clock offset: the search range is below its step");
+  const bool weighted = std::all_of(weights.begin(), weights.end(),
+                                    [](double w) { return std::isfinite(w) && w > 0.0; });
+  if (!weights.empty() && (weights.size() != estimates.size() || !weighted)) {
+    throw std::invalid_argument("clock offset: one positive weight per estimate, or none");
+  }
   const std::vector<Trajectory> sorted = sortedEstimates(estimates, ref);
   ClockOffset result;
-  const std::vector<double> total = summedCurve(ref, sorted, half, max_offset, result.turns);
+  const std::vector<double> total =
+      summedCurve(ref, sorted, weights, half, max_offset, result.turns);
   result.offset = bestOffset(total, half, max_offset);
   addTurnRms(ref, sorted, result);
   return result;
