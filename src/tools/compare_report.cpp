@@ -88,7 +88,7 @@ void evaluateRows(std::vector<CompareRow>& rows, const std::optional<Trajectory>
       weights.push_back(1.0 / rows_of[row.method]);
     }
     try {
-      at = estimateClockOffset(*reference, trajectories, 0.05, weights).offset;
+      at = estimateClockOffset(*reference, trajectories, weights).offset;
       notes.push_back("# " + name + ": the frames' stamps " + milliseconds(at) +
                       " against the reference's (--offset auto)");
     } catch (const std::exception& e) {

@@ -325,10 +325,10 @@ TEST(ClockOffset, WeightsGiveEachMethodOneVote) {
   }
   EXPECT_NEAR(acvo::estimateClockOffset(gt, estimates).offset, 0.014, 1e-3);
   const std::vector<double> one_vote{1.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0};
-  EXPECT_NEAR(acvo::estimateClockOffset(gt, estimates, 0.05, one_vote).offset, 0.012, 1e-3);
+  EXPECT_NEAR(acvo::estimateClockOffset(gt, estimates, one_vote).offset, 0.012, 1e-3);
   // One positive weight per estimate, or none.
-  EXPECT_THROW(acvo::estimateClockOffset(gt, estimates, 0.05, {1.0, 1.0}), std::invalid_argument);
-  EXPECT_THROW(acvo::estimateClockOffset(gt, estimates, 0.05, {1.0, 0.0, 1.0, 1.0}),
+  EXPECT_THROW(acvo::estimateClockOffset(gt, estimates, {1.0, 1.0}), std::invalid_argument);
+  EXPECT_THROW(acvo::estimateClockOffset(gt, estimates, {1.0, 0.0, 1.0, 1.0}),
                std::invalid_argument);
 }
 

@@ -98,7 +98,8 @@ struct ClockOffset {
 // the best offset is at the search's edge, or when the reference turns too little for the offset
 // to show (the curve's ends within 5% of its least value).
 ClockOffset estimateClockOffset(const Trajectory& groundtruth,
-                                const std::vector<Trajectory>& estimates, double max_offset = 0.05,
-                                const std::vector<double>& weights = {});
+                                const std::vector<Trajectory>& estimates,
+                                const std::vector<double>& weights = {},
+                                double max_offset = 0.05);
 
 }  // namespace acvo

@@ -13,11 +13,13 @@
 
 #include <Eigen/Geometry>
 
+#include "stamp_association.hpp"
 #include "trajectory_stamps.hpp"
 
 namespace acvo {
 namespace {
 
+using detail::associateStamps;
 using detail::byStamp;
 using detail::medianInterval;
 using detail::stampsOf;
@@ -119,18 +121,6 @@ Reference referenceOf(const Trajectory& groundtruth) {
   return ref;
 }
 
-// How many of the estimate's stamps a reference stamp lies within kSameInstant of.
-std::size_t atReferenceStamps(const Trajectory& est, const Reference& ref) {
-  std::size_t n = 0;
-  for (const StampedPose& p : est) {
-    const auto after = std::lower_bound(ref.stamps.begin(), ref.stamps.end(), p.stamp);
-    const bool at_after = after != ref.stamps.end() && *after - p.stamp <= kSameInstant;
-    const bool at_before = after != ref.stamps.begin() && p.stamp - *(after - 1) <= kSameInstant;
-    n += at_after || at_before ? 1 : 0;
-  }
-  return n;
-}
-
 // The estimates sorted by stamp. Between a reference's samples its turn is an interpolation:
 // sampled no faster than the frames, the offset found would be the one at which the
 // interpolation smooths best; throws there. A reference whose poses carry the frames' own
@@ -142,17 +132,18 @@ std::vector<Trajectory> sortedEstimates(const std::vector<Trajectory>& estimates
   for (const Trajectory& trajectory : estimates) {
     sorted.push_back(byStamp(trajectory));
     if (sorted.back().size() <= 2) continue;
-    const double frame_interval = medianInterval(stampsOf(sorted.back()));
+    const std::vector<double> stamps = stampsOf(sorted.back());
+    const double frame_interval = medianInterval(stamps);
     if (!(ref.interval <= kReferenceRateRatio * frame_interval)) {
       throw std::runtime_error(
           "clock offset: the reference is sampled every " + std::to_string(ref.interval) +
           " s, not at least twice as often as the frames (every " +
           std::to_string(frame_interval) + " s): its clock cannot be told from its frames'");
     }
-    const std::size_t own = atReferenceStamps(sorted.back(), ref);
-    if (double(own) > kOwnStampsShare * double(sorted.back().size())) {
+    const std::size_t own = associateStamps(stamps, ref.stamps, kSameInstant).size();
+    if (double(own) > kOwnStampsShare * double(stamps.size())) {
       throw std::runtime_error("clock offset: " + std::to_string(own) + " of the " +
-                               std::to_string(sorted.back().size()) +
+                               std::to_string(stamps.size()) +
                                " frames' stamps are the reference's own: a reference of one "
                                "pose per frame has no clock of its own");
     }
@@ -212,8 +203,8 @@ void addTurnRms(const Reference& ref, const std::vector<Trajectory>& sorted, Clo
 }  // namespace
 
 ClockOffset estimateClockOffset(const Trajectory& groundtruth,
-                                const std::vector<Trajectory>& estimates, double max_offset,
-                                const std::vector<double>& weights) {
+                                const std::vector<Trajectory>& estimates,
+                                const std::vector<double>& weights, double max_offset) {
   const Reference ref = referenceOf(groundtruth);
   const int half = int(std::lround(max_offset / kOffsetStep));
   if (half < 1) throw std::runtime_error("clock offset: the search range is below its step");
