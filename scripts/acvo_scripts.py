@@ -1,5 +1,5 @@
 """What the scripts share (scripts/bench, bag_rate, soak_nodelet, and the folder tools
-depth_noise, distort_tum, downsample_tum, register_colour).
+depth_distortion, depth_noise, distort_tum, downsample_tum, register_colour).
 
   paths        the repository, the workspace, the built tools, the shared data sets
   build        scripts/build with its log, the path of a built tool
