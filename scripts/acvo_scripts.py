@@ -1,10 +1,10 @@
-"""What the scripts share (scripts/bench, bag_rate, soak_nodelet, and the folder tools
-depth_distortion, depth_noise, distort_tum, downsample_tum, register_colour).
+"""What the scripts share (scripts/bench, bag_rate, soak_nodelet, window_errors, and the folder
+tools depth_distortion, depth_noise, distort_tum, downsample_tum, register_colour).
 
   paths        the repository, the workspace, the built tools, the shared data sets
   build        scripts/build with its log, the path of a built tool
-  datasets     a folder's associations and depth images, synthetic sequences rendered once by
-               acvo_synth, the real data sets, names
+  datasets     a folder's associations and depth images, TUM trajectories and their poses,
+               synthetic sequences rendered once by acvo_synth, the real data sets, names
   statistics   percentile and slope (numpy)
   machine      the "machine:" line printed with every figure (nproc, CPU, load, date, commit)
   /proc        memory, CPU time and liveness of a process, the machine's CPU and load
@@ -140,6 +140,36 @@ def depth_metres(raw, scale):
     depth = raw.astype(np.float32) / np.float32(scale)
     depth[(raw == 0) | (raw == 65535)] = np.nan
     return depth
+
+
+def read_trajectory(path, offset=0.0):
+    """A TUM trajectory file ("stamp tx ty tz qx qy qz qw" lines; further columns ignored) as an
+    (n, 8) numpy array sorted by stamp, `offset` added to the stamps. ValueError on another
+    layout, OSError without the file."""
+    import numpy as np
+    rows = []
+    with open(path) as f:
+        for line in f:
+            if line.strip() and not line.startswith('#'):
+                rows.append([float(x) for x in line.split()[:8]])
+    a = np.array(rows)
+    if a.ndim != 2 or a.shape[1] != 8:
+        raise ValueError('%s: expected lines "stamp tx ty tz qx qy qz qw"' % path)
+    a[:, 0] += offset
+    return a[np.argsort(a[:, 0])]
+
+
+def pose_matrix(row):
+    """The 4x4 transform of a trajectory row (stamp, translation, quaternion x y z w; the
+    quaternion normalised)."""
+    import numpy as np
+    x, y, z, w = row[4:8] / np.linalg.norm(row[4:8])
+    T = np.eye(4)
+    T[:3, :3] = [[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                 [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                 [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]]
+    T[:3, 3] = row[1:4]
+    return T
 
 
 def count_frames(folder):
