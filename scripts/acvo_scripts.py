@@ -133,6 +133,21 @@ def read_associations(folder):
     return rows
 
 
+def read_camera_yaml(folder):
+    """A folder's camera.yaml as YAML reads it ({} when empty). OSError without the file,
+    yaml.YAMLError where it is not YAML."""
+    import yaml
+    with open(os.path.join(folder, "camera.yaml")) as f:
+        return yaml.safe_load(f) or {}
+
+
+def intrinsic_matrix(camera):
+    """The 3x3 intrinsic matrix of camera.yaml's fx, fy, cx and cy (KeyError without one)."""
+    import numpy as np
+    return np.array([[float(camera["fx"]), 0, float(camera["cx"])],
+                     [0, float(camera["fy"]), float(camera["cy"])], [0, 0, 1.0]])
+
+
 def depth_metres(raw, scale):
     """A 16-bit depth image in metres (float32), NaN where it holds no reading: 0, or 65535 as
     7-Scenes marks it (acvo's depthToMeters)."""
