@@ -3,8 +3,8 @@ tools depth_distortion, depth_noise, distort_tum, downsample_tum, register_colou
 
   paths        the repository, the workspace, the built tools, the shared data sets
   build        scripts/build with its log, the path of a built tool
-  datasets     a folder's associations and depth images, TUM trajectories and their poses,
-               synthetic sequences rendered once by acvo_synth, the real data sets, names
+  datasets     a folder's associations, camera.yaml and depth images, TUM trajectories and their
+               poses, synthetic sequences rendered once by acvo_synth, the real data sets, names
   statistics   percentile and slope (numpy)
   machine      the "machine:" line printed with every figure (nproc, CPU, load, date, commit)
   /proc        memory, CPU time and liveness of a process, the machine's CPU and load
